@@ -1,0 +1,817 @@
+"""scenefit Blender worker: renders scenefit-scene/1 JSON scenes with Cycles.
+
+Run (persistent JSON-lines worker, see DESIGN.md "Renderer plug-in protocol"):
+
+    blender -b --factory-startup -noaudio --python-exit-code 1 \
+        -P blender_scripts/worker.py -- [--threads N] [--quiet]
+
+Protocol
+--------
+At start the script keeps a private duplicate of fd 1 for protocol messages
+and points fd 1 at fd 2 (``--quiet``: at /dev/null), so that everything
+Blender/Cycles print after that goes to stderr.  NOTE: Blender itself prints
+a banner ("Blender 3.4.1" and an empty line) on stdout *before* this script
+runs; a client must skip non-JSON lines until the ready line.
+
+    -> {"ready": true, "renderer": "blender 3.4.1"}
+    <- {"id": 17, "scene": {...}, "output": "/path/17.png", "seed": 5}
+    -> {"id": 17, "ok": true}      or   {"id": 17, "ok": false, "error": "..."}
+
+"seed" is optional (default 0); unknown request keys are ignored.  A line
+that is not JSON, or a scene that cannot be built, is answered with ok:false
+(id null when it cannot be read) and the worker keeps serving.  EOF on stdin
+ends the worker with exit code 0.  stderr carries Blender's render log and
+must be drained (or redirected) by the client.
+
+Scene -> Blender mapping (docs/conventions-draft.md)
+----------------------------------------------------
+Coordinates: scene is right-handed, y up, metres; Blender is right-handed,
+z up.  A scene point (x, y, z) becomes Blender (x, -z, y) (a +90 deg rotation
+about x: no mirroring).
+
+Camera
+  perspective: sensor_fit VERTICAL, angle_y = fov_y_deg (vertical FOV).
+  orthographic: sensor_fit VERTICAL, ortho_scale = height (vertical extent).
+  Oriented from position / look_at / up (camera -Z looks at look_at, +Y is
+  the component of `up` orthogonal to the view direction).  Clip range
+  1e-4 .. 1e6 m.  Resolution image.width x image.height, 100 %, pixel
+  aspect 1.
+Lights (light objects are invisible to camera rays)
+  point: POINT light at position, power P = 4*pi*I W (Cycles gives P/(4 pi)
+    W/sr), colour = color, shadow_soft_size = radius (same total power).
+    falloff "none": light node tree Light Falloff(Strength 1).Constant ->
+    Emission strength, which cancels the 1/d^2 (E = I cos(theta), as if at
+    1 m).
+  directional: SUN with strength E (W/m^2), angle 0, colour = color, its
+    emission direction is -direction.
+Ambient
+  World: Background(color = ambient, strength 1) seen by every ray except
+  camera rays (Light Path "Is Camera Ray" -> empty shader = black).  World
+  importance sampling is off when ambient is black.
+Shapes
+  sphere: a shared smooth-shaded UV-sphere mesh (128 segments x 64 rings,
+    unit radius, vertices pushed out by 1/sqrt(cos(pi/128)) so the faceted
+    silhouette straddles the true one); the object carries centre
+    (location) and radius (uniform scale).  Silhouette error <= 1.5e-4 of
+    the radius (under 0.01 px for a sphere 50 px in radius; measured: a
+    40 px sphere covers 5026.0 px^2 against pi*40^2 = 5026.55).
+  plane: a 2 km x 2 km quad (shared mesh), located at `point`, local +Z
+    rotated onto `normal`.
+  quad: its own 4-vertex mesh corner, corner+u, corner+u+v, corner+v.
+  box: a shared flat-shaded unit cube [0,1]^3, location = min, scale = size.
+  Cycles shades both sides of every face.
+Materials (per object, linked to the object's material slot)
+  specular = reflection = transmission = 0: Diffuse BSDF (Lambertian),
+    roughness 0, colour = diffuse*color.
+  otherwise: Principled BSDF (GGX), Base Color = diffuse*color, Metallic 0,
+    Specular = clamp(specular, 0, 1) (F0 = 0.08*Specular, so specular 0.5 <->
+    F0 0.04), Roughness = (2/(shininess+2))^(1/4), Transmission =
+    transmission, Transmission Roughness 0, IOR = ior; then Mix Shader
+    (fac = reflection) with a white Glossy BSDF (GGX, roughness 0 = mirror).
+Render
+  Cycles, CPU, samples = render.samples, adaptive sampling off, denoising
+  off, pixel filter BOX width 1, seed = request seed (not animated), clamping
+  off, light sampling threshold 0, no path guiding.  render.indirect true:
+  8 bounces of every kind; false: all bounces 0 (direct light only).
+  View transform Standard, look None, exposure 0, gamma 1, no curves, film
+  exposure 1, dither 0, film not transparent.  Output PNG 8-bit RGB.
+Reuse
+  The built scene is kept.  If a request's scene has the same structure
+  (camera type; lights by name, type and falloff kind; objects by name,
+  shape type and material kind lambertian/principled) as the previous one,
+  only values are updated in place; otherwise every datablock the worker
+  made is removed (bpy.data.*.remove) and the scene is rebuilt.  Cycles
+  persistent data is on, so unchanged geometry (BVH) and shaders are kept
+  between renders.
+"""
+
+import json
+import math
+import os
+import struct
+import sys
+import time
+import traceback
+
+TIMING = bool(os.environ.get("SCENEFIT_WORKER_TIMING"))
+
+# ---------------------------------------------------------------------------
+# stdout discipline: keep a private protocol channel, send the noise away.
+# ---------------------------------------------------------------------------
+
+
+def _args_after_dashdash():
+    argv = sys.argv
+    return argv[argv.index("--") + 1:] if "--" in argv else []
+
+
+def _parse_args(args):
+    """--threads N (default 1; 0 = Blender's automatic count), --quiet."""
+    opts = {"threads": 1, "quiet": False}
+    i = 0
+    while i < len(args):
+        a = args[i]
+        val = None
+        if a == "--threads" and i + 1 < len(args):
+            val = args[i + 1]
+            i += 1
+        elif a.startswith("--threads="):
+            val = a.split("=", 1)[1]
+        elif a == "--quiet":
+            opts["quiet"] = True
+        else:
+            sys.stderr.write("worker.py: ignoring unknown argument %r\n" % a)
+        if val is not None:
+            try:
+                opts["threads"] = max(0, int(val))
+            except ValueError:
+                sys.stderr.write("worker.py: bad --threads %r, using 1\n" % val)
+        i += 1
+    return opts
+
+
+_PROTO = None
+
+
+def _take_stdout(quiet):
+    """Keep a private copy of fd 1 for the protocol; fd 1 -> stderr (or null)."""
+    global _PROTO
+    sys.stdout.flush()
+    _PROTO = os.fdopen(os.dup(1), "w", buffering=1, encoding="utf-8")
+    if quiet:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, 1)
+        os.close(devnull)
+    else:
+        os.dup2(2, 1)
+
+
+def send(msg):
+    _PROTO.write(json.dumps(msg) + "\n")
+    _PROTO.flush()
+
+
+def log(*a):
+    sys.stderr.write("worker.py: " + " ".join(str(x) for x in a) + "\n")
+    sys.stderr.flush()
+
+
+import bpy  # noqa: E402
+import bmesh  # noqa: E402
+from mathutils import Matrix, Vector  # noqa: E402
+
+PREFIX = "sf_"  # every datablock this worker creates is named sf_*
+# 128 x 64 keeps the silhouette within 1.5e-4 of the radius.  Cycles re-syncs
+# a mesh whose object moves: a 256 x 128 sphere added ~0.03 s to each render
+# that moved it, 128 x 64 adds ~0.007 s.
+SPHERE_SEGMENTS = int(os.environ.get("SCENEFIT_SPHERE_SEGMENTS", 128))
+SPHERE_RINGS = SPHERE_SEGMENTS // 2
+PLANE_HALF = 1000.0  # the "infinite" plane is a 2 km quad
+
+
+class SceneError(Exception):
+    pass
+
+
+# ---------------------------------------------------------------------------
+# scene JSON helpers
+# ---------------------------------------------------------------------------
+
+
+def _num(d, key, where, default=None):
+    if key not in d:
+        if default is None:
+            raise SceneError("missing '%s' in %s" % (key, where))
+        return float(default)
+    v = d[key]
+    if isinstance(v, bool) or not isinstance(v, (int, float)):
+        raise SceneError("'%s' in %s must be a number, got %r" % (key, where, v))
+    if not math.isfinite(v):
+        raise SceneError("'%s' in %s is not finite" % (key, where))
+    return float(v)
+
+
+def _vec3(d, key, where, default=None):
+    if key not in d:
+        if default is None:
+            raise SceneError("missing '%s' in %s" % (key, where))
+        return tuple(float(x) for x in default)
+    v = d[key]
+    if (not isinstance(v, list) or len(v) != 3
+            or any(isinstance(x, bool) or not isinstance(x, (int, float)) for x in v)):
+        raise SceneError("'%s' in %s must be a list of 3 numbers, got %r" % (key, where, v))
+    if not all(math.isfinite(x) for x in v):
+        raise SceneError("'%s' in %s is not finite" % (key, where))
+    return tuple(float(x) for x in v)
+
+
+def _obj(d, key, where, required=True):
+    if key not in d:
+        if required:
+            raise SceneError("missing '%s' in %s" % (key, where))
+        return {}
+    v = d[key]
+    if not isinstance(v, dict):
+        raise SceneError("'%s' in %s must be an object" % (key, where))
+    return v
+
+
+def _f32(x):
+    return struct.unpack("f", struct.pack("f", x))[0]
+
+
+def _set(owner, attr, value):
+    """Assign only when the (float32) value changes: every RNA assignment tags
+    the datablock for a depsgraph / Cycles update, even with an equal value."""
+    cur = getattr(owner, attr)
+    if isinstance(value, (int, float)):
+        same = cur == _f32(value)
+    else:
+        value = tuple(value)
+        same = len(cur) == len(value) and all(c == _f32(v) for c, v in zip(cur, value))
+    if not same:
+        setattr(owner, attr, value)
+
+
+def B(p):
+    """Scene (y up) point/vector -> Blender (z up)."""
+    return Vector((p[0], -p[2], p[1]))
+
+
+def _rot_z_to(direction, where):
+    d = Vector(direction)
+    if d.length < 1e-12:
+        raise SceneError("zero-length direction in %s" % where)
+    return d.normalized().to_track_quat("Z", "Y")
+
+
+def material_kind(m, where="material"):
+    spec = _num(m, "specular", where, 0.0)
+    refl = _num(m, "reflection", where, 0.0)
+    trans = _num(m, "transmission", where, 0.0)
+    return "lambertian" if spec == 0.0 and refl == 0.0 and trans == 0.0 else "principled"
+
+
+def structure_of(scene):
+    """The part of a scene that decides which datablocks exist."""
+    if not isinstance(scene, dict):
+        raise SceneError("'scene' must be an object")
+    cam = _obj(scene, "camera", "scene")
+    lights = scene.get("lights", [])
+    objects = scene.get("objects", [])
+    if not isinstance(lights, list):
+        raise SceneError("'lights' must be a list")
+    if not isinstance(objects, list):
+        raise SceneError("'objects' must be a list")
+    ls = []
+    for i, l in enumerate(lights):
+        where = "lights[%d]" % i
+        if not isinstance(l, dict):
+            raise SceneError("%s must be an object" % where)
+        ls.append((str(l.get("name", "light%d" % i)), l.get("type"),
+                   l.get("falloff", "inverse_square")))
+    os_ = []
+    for i, o in enumerate(objects):
+        where = "objects[%d]" % i
+        if not isinstance(o, dict):
+            raise SceneError("%s must be an object" % where)
+        shape = _obj(o, "shape", where)
+        mat = _obj(o, "material", where, required=False)
+        os_.append((str(o.get("name", "object%d" % i)), shape.get("type"),
+                    material_kind(mat, "object '%s' material" % o.get("name", i))))
+    return (cam.get("type"), tuple(ls), tuple(os_))
+
+
+# ---------------------------------------------------------------------------
+# the worker's Blender state
+# ---------------------------------------------------------------------------
+
+
+class Worker:
+    def __init__(self, threads):
+        self.threads = threads
+        self.structure = None  # structure of the built scene, None = nothing valid
+        self.cam_obj = None
+        self.cam_key = None
+        self.lights = []   # list of (light object, falloff node or None)
+        self.objects = []  # list of dicts: obj, shape, mesh(own), nodes
+        self.scene = bpy.context.scene
+        self._wipe_factory_scene()
+        self._setup_render_constants()
+        self._setup_world()
+        self._templates = {}
+
+    # -- one-time setup ---------------------------------------------------
+    def _wipe_factory_scene(self):
+        for o in list(bpy.data.objects):
+            bpy.data.objects.remove(o, do_unlink=True)
+        for coll in (bpy.data.meshes, bpy.data.materials, bpy.data.lights,
+                     bpy.data.cameras, bpy.data.worlds):
+            for d in list(coll):
+                coll.remove(d)
+
+    def _setup_render_constants(self):
+        s = self.scene
+        r = s.render
+        r.engine = "CYCLES"
+        c = s.cycles
+        c.device = "CPU"
+        c.feature_set = "SUPPORTED"
+        c.use_adaptive_sampling = False
+        c.use_denoising = False
+        c.use_preview_denoising = False
+        c.pixel_filter_type = "BOX"
+        c.filter_width = 1.0
+        c.use_animated_seed = False
+        c.sample_clamp_direct = 0.0
+        c.sample_clamp_indirect = 0.0
+        c.light_sampling_threshold = 0.0
+        c.blur_glossy = 0.0
+        c.sample_offset = 0
+        c.use_layer_samples = "IGNORE"
+        c.film_exposure = 1.0
+        c.use_fast_gi = False
+        c.caustics_reflective = True
+        c.caustics_refractive = True
+        c.min_light_bounces = 0
+        c.min_transparent_bounces = 0
+        c.time_limit = 0.0
+        c.use_camera_cull = False
+        c.use_distance_cull = False
+        if hasattr(c, "use_guiding"):
+            c.use_guiding = False
+        if hasattr(c, "use_light_tree"):  # Blender >= 3.5
+            c.use_light_tree = False
+        r.film_transparent = False
+        r.use_persistent_data = True
+        if self.threads > 0:
+            r.threads_mode = "FIXED"
+            r.threads = self.threads
+        else:
+            r.threads_mode = "AUTO"
+        r.resolution_percentage = 100
+        r.pixel_aspect_x = 1.0
+        r.pixel_aspect_y = 1.0
+        r.use_border = False
+        r.use_motion_blur = False
+        r.dither_intensity = 0.0
+        r.use_compositing = False
+        r.use_sequencer = False
+        r.use_file_extension = False
+        im = r.image_settings
+        im.file_format = "PNG"
+        im.color_mode = "RGB"
+        im.color_depth = "8"
+        im.compression = 0
+        s.display_settings.display_device = "sRGB"
+        v = s.view_settings
+        v.view_transform = "Standard"
+        v.look = "None"
+        v.exposure = 0.0
+        v.gamma = 1.0
+        v.use_curve_mapping = False
+        s.sequencer_colorspace_settings.name = "sRGB"
+        s.frame_set(1)
+        # the active view layer: keep only the combined pass
+        vl = s.view_layers[0]
+        vl.use_pass_combined = True
+        vl.use_pass_z = False
+
+    def _setup_world(self):
+        w = bpy.data.worlds.new(PREFIX + "world")
+        w.use_nodes = True
+        nt = w.node_tree
+        nt.nodes.clear()
+        out = nt.nodes.new("ShaderNodeOutputWorld")
+        bg = nt.nodes.new("ShaderNodeBackground")
+        lp = nt.nodes.new("ShaderNodeLightPath")
+        mix = nt.nodes.new("ShaderNodeMixShader")
+        bg.inputs["Strength"].default_value = 1.0
+        nt.links.new(lp.outputs["Is Camera Ray"], mix.inputs[0])
+        nt.links.new(bg.outputs["Background"], mix.inputs[1])
+        # mix.inputs[2] left empty: camera rays see black
+        nt.links.new(mix.outputs["Shader"], out.inputs["Surface"])
+        w.cycles.sampling_method = "MANUAL"
+        w.cycles.sample_map_resolution = 32
+        w.cycles.max_bounces = 1024
+        self.scene.world = w
+        self.world_bg = bg
+        self.world = w
+
+    def template(self, kind):
+        """Shared meshes, created once and never removed."""
+        me = self._templates.get(kind)
+        if me is not None:
+            return me
+        bm = bmesh.new()
+        if kind == "sphere":
+            bmesh.ops.create_uvsphere(bm, u_segments=SPHERE_SEGMENTS,
+                                      v_segments=SPHERE_RINGS, radius=1.0)
+            # vertices lie on the unit sphere, faces inside it; push out so
+            # the silhouette error is split evenly (about half the sagitta).
+            k = 1.0 / math.cos(math.pi / SPHERE_SEGMENTS) ** 0.5
+            for v in bm.verts:
+                v.co *= k
+            smooth = True
+        elif kind == "plane":
+            h = PLANE_HALF
+            vs = [bm.verts.new(c) for c in ((-h, -h, 0), (h, -h, 0), (h, h, 0), (-h, h, 0))]
+            bm.faces.new(vs)
+            smooth = False
+        elif kind == "box":
+            bmesh.ops.create_cube(bm, size=1.0)
+            bmesh.ops.translate(bm, verts=bm.verts, vec=(0.5, 0.5, 0.5))
+            smooth = False
+        else:
+            raise AssertionError(kind)
+        me = bpy.data.meshes.new(PREFIX + "template_" + kind)
+        bm.to_mesh(me)
+        bm.free()
+        for p in me.polygons:
+            p.use_smooth = smooth
+        me.materials.append(None)  # one slot; the material is linked per object
+        me.use_fake_user = True
+        self._templates[kind] = me
+        return me
+
+    # -- build / clear ------------------------------------------------------
+    def clear(self):
+        self.structure = None
+        coll = self.scene.collection
+        for o in list(coll.objects):
+            bpy.data.objects.remove(o, do_unlink=True)
+        for o in list(bpy.data.objects):
+            bpy.data.objects.remove(o, do_unlink=True)
+        templates = set(self._templates.values())
+        for me in list(bpy.data.meshes):
+            if me not in templates:
+                bpy.data.meshes.remove(me)
+        for coll_ in (bpy.data.materials, bpy.data.lights, bpy.data.cameras):
+            for d in list(coll_):
+                coll_.remove(d)
+        self.cam_obj = None
+        self.cam_key = None
+        self.lights = []
+        self.objects = []
+
+    def build(self, scene, structure):
+        self.clear()
+        coll = self.scene.collection
+        cam_type, light_structs, obj_structs = structure
+
+        # camera
+        if cam_type not in ("perspective", "orthographic"):
+            raise SceneError("camera.type must be 'perspective' or 'orthographic', got %r" % (cam_type,))
+        cd = bpy.data.cameras.new(PREFIX + "camera")
+        cd.type = "PERSP" if cam_type == "perspective" else "ORTHO"
+        cd.sensor_fit = "VERTICAL"
+        cd.clip_start = 1e-4
+        cd.clip_end = 1e6
+        cd.shift_x = cd.shift_y = 0.0
+        cam = bpy.data.objects.new(PREFIX + "camera", cd)
+        coll.objects.link(cam)
+        self.scene.camera = cam
+        self.cam_obj = cam
+
+        # lights
+        for i, (name, ltype, falloff) in enumerate(light_structs):
+            where = "light '%s'" % name
+            if ltype == "point":
+                ld = bpy.data.lights.new(PREFIX + "light_" + name, "POINT")
+            elif ltype == "directional":
+                ld = bpy.data.lights.new(PREFIX + "light_" + name, "SUN")
+            else:
+                raise SceneError("%s: type must be 'point' or 'directional', got %r" % (where, ltype))
+            if falloff not in ("inverse_square", "none"):
+                raise SceneError("%s: falloff must be 'inverse_square' or 'none', got %r" % (where, falloff))
+            fnode = None
+            if falloff == "none" and ltype == "point":
+                ld.use_nodes = True
+                nt = ld.node_tree
+                nt.nodes.clear()
+                out = nt.nodes.new("ShaderNodeOutputLight")
+                em = nt.nodes.new("ShaderNodeEmission")
+                fnode = nt.nodes.new("ShaderNodeLightFalloff")
+                fnode.inputs["Strength"].default_value = 1.0
+                fnode.inputs["Smooth"].default_value = 0.0
+                em.inputs["Color"].default_value = (1, 1, 1, 1)
+                nt.links.new(fnode.outputs["Constant"], em.inputs["Strength"])
+                nt.links.new(em.outputs["Emission"], out.inputs["Surface"])
+            ld.cycles.cast_shadow = True
+            ld.cycles.use_multiple_importance_sampling = True
+            ld.cycles.max_bounces = 1024
+            lo = bpy.data.objects.new(PREFIX + "light_" + name, ld)
+            lo.rotation_mode = "QUATERNION"
+            lo.visible_camera = False
+            coll.objects.link(lo)
+            self.lights.append((lo, fnode))
+
+        # objects
+        for i, (name, stype, mkind) in enumerate(obj_structs):
+            where = "object '%s'" % name
+            own_mesh = None
+            if stype in ("sphere", "plane", "box"):
+                me = self.template(stype)
+            elif stype == "quad":
+                me = bpy.data.meshes.new(PREFIX + "quad_" + name)
+                me.from_pydata([(0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0)], [], [(0, 1, 2, 3)])
+                me.materials.append(None)
+                own_mesh = me
+            else:
+                raise SceneError("%s: shape.type must be sphere, plane, quad or box, got %r" % (where, stype))
+            ob = bpy.data.objects.new(PREFIX + "obj_" + name, me)
+            ob.rotation_mode = "QUATERNION"
+            coll.objects.link(ob)
+            mat, nodes = self._make_material(PREFIX + "mat_" + name, mkind)
+            ob.material_slots[0].link = "OBJECT"
+            ob.material_slots[0].material = mat
+            self.objects.append({"obj": ob, "shape": stype, "mesh": own_mesh,
+                                 "kind": mkind, "nodes": nodes, "mat": mat})
+        self.structure = structure
+
+    def _make_material(self, name, kind):
+        mat = bpy.data.materials.new(name)
+        mat.use_nodes = True
+        nt = mat.node_tree
+        nt.nodes.clear()
+        out = nt.nodes.new("ShaderNodeOutputMaterial")
+        out.target = "ALL"
+        nodes = {}
+        if kind == "lambertian":
+            d = nt.nodes.new("ShaderNodeBsdfDiffuse")
+            d.inputs["Roughness"].default_value = 0.0
+            nt.links.new(d.outputs["BSDF"], out.inputs["Surface"])
+            nodes["diffuse"] = d
+        else:
+            p = nt.nodes.new("ShaderNodeBsdfPrincipled")
+            p.distribution = "GGX"
+            p.subsurface_method = "BURLEY"
+            for k, v in (("Metallic", 0.0), ("Specular Tint", 0.0), ("Anisotropic", 0.0),
+                         ("Sheen", 0.0), ("Clearcoat", 0.0), ("Subsurface", 0.0),
+                         ("Transmission Roughness", 0.0), ("Alpha", 1.0)):
+                if k in p.inputs:
+                    p.inputs[k].default_value = v
+            if "Emission Strength" in p.inputs:
+                p.inputs["Emission Strength"].default_value = 0.0
+            p.inputs["Emission"].default_value = (0, 0, 0, 1)
+            g = nt.nodes.new("ShaderNodeBsdfGlossy")
+            g.distribution = "GGX"
+            g.inputs["Color"].default_value = (1, 1, 1, 1)
+            g.inputs["Roughness"].default_value = 0.0
+            mix = nt.nodes.new("ShaderNodeMixShader")
+            nt.links.new(p.outputs["BSDF"], mix.inputs[1])
+            nt.links.new(g.outputs["BSDF"], mix.inputs[2])
+            nt.links.new(mix.outputs["Shader"], out.inputs["Surface"])
+            nodes["principled"] = p
+            nodes["mix"] = mix
+        return mat, nodes
+
+    # -- values -------------------------------------------------------------
+    def apply(self, scene):
+        s = self.scene
+        r = s.render
+        img = _obj(scene, "image", "scene")
+        w = int(_num(img, "width", "image"))
+        h = int(_num(img, "height", "image"))
+        if w < 1 or h < 1 or w > 65536 or h > 65536:
+            raise SceneError("image size %dx%d out of range" % (w, h))
+        if r.resolution_x != w:
+            r.resolution_x = w
+        if r.resolution_y != h:
+            r.resolution_y = h
+
+        rd = _obj(scene, "render", "scene", required=False)
+        samples = int(_num(rd, "samples", "render", 16))
+        if samples < 1:
+            raise SceneError("render.samples must be >= 1")
+        indirect = rd.get("indirect", True)
+        if not isinstance(indirect, bool):
+            raise SceneError("render.indirect must be true or false")
+        c = s.cycles
+        nb = 8 if indirect else 0
+        for attr, val in (("samples", samples), ("max_bounces", nb), ("diffuse_bounces", nb),
+                          ("glossy_bounces", nb), ("transmission_bounces", nb),
+                          ("transparent_max_bounces", nb), ("volume_bounces", 0)):
+            if getattr(c, attr) != val:
+                setattr(c, attr, val)
+
+        # camera
+        cam = _obj(scene, "camera", "scene")
+        pos = B(_vec3(cam, "position", "camera"))
+        look = B(_vec3(cam, "look_at", "camera"))
+        up = B(_vec3(cam, "up", "camera", (0, 1, 0)))
+        f = look - pos
+        if f.length < 1e-12:
+            raise SceneError("camera.position equals camera.look_at")
+        f.normalize()
+        right = f.cross(up)
+        if right.length < 1e-9:
+            raise SceneError("camera.up is parallel to the view direction")
+        right.normalize()
+        tup = right.cross(f)
+        m = Matrix((right, tup, -f)).transposed().to_4x4()
+        m.translation = pos
+        if self.cam_key != (tuple(pos), tuple(look), tuple(up)):
+            self.cam_obj.matrix_world = m
+            self.cam_key = (tuple(pos), tuple(look), tuple(up))
+        cd = self.cam_obj.data
+        if cd.type == "PERSP":
+            fov = _num(cam, "fov_y_deg", "camera")
+            if not (0.0 < fov < 180.0):
+                raise SceneError("camera.fov_y_deg must be in (0, 180)")
+            if abs(cd.angle_y - math.radians(fov)) > 1e-7 * math.radians(fov):
+                cd.angle_y = math.radians(fov)
+        else:
+            height = _num(cam, "height", "camera")
+            if height <= 0:
+                raise SceneError("camera.height must be > 0")
+            _set(cd, "ortho_scale", height)
+
+        # ambient
+        amb = _vec3(scene, "ambient", "scene", (0, 0, 0))
+        _set(self.world_bg.inputs["Color"], "default_value", (amb[0], amb[1], amb[2], 1.0))
+        want = "MANUAL" if any(a != 0.0 for a in amb) else "NONE"
+        if self.world.cycles.sampling_method != want:
+            self.world.cycles.sampling_method = want
+
+        # lights
+        for (lo, fnode), l in zip(self.lights, scene.get("lights", [])):
+            name = l.get("name", "?")
+            where = "light '%s'" % name
+            ld = lo.data
+            col = _vec3(l, "color", where, (1, 1, 1))
+            inten = _num(l, "intensity", where)
+            if inten < 0:
+                raise SceneError("%s: intensity must be >= 0" % where)
+            _set(ld, "color", col)
+            if ld.type == "POINT":
+                _set(lo, "location", B(_vec3(l, "position", where)))
+                _set(ld, "energy", 4.0 * math.pi * inten)
+                rad = _num(l, "radius", where, 0.0)
+                if rad < 0:
+                    raise SceneError("%s: radius must be >= 0" % where)
+                _set(ld, "shadow_soft_size", rad)
+            else:
+                d = B(_vec3(l, "direction", where))
+                _set(lo, "rotation_quaternion", _rot_z_to(d, where))
+                _set(ld, "energy", inten)
+                ld.angle = 0.0
+
+        # objects
+        for ent, o in zip(self.objects, scene.get("objects", [])):
+            name = o.get("name", "?")
+            where = "object '%s'" % name
+            ob = ent["obj"]
+            sh = o["shape"]
+            st = ent["shape"]
+            if st == "sphere":
+                rad = _num(sh, "radius", where + " shape")
+                if rad <= 0:
+                    raise SceneError("%s: radius must be > 0" % where)
+                _set(ob, "location", B(_vec3(sh, "center", where + " shape")))
+                _set(ob, "scale", (rad, rad, rad))
+            elif st == "plane":
+                _set(ob, "location", B(_vec3(sh, "point", where + " shape")))
+                _set(ob, "rotation_quaternion", _rot_z_to(B(_vec3(sh, "normal", where + " shape")), where))
+            elif st == "box":
+                lo_ = _vec3(sh, "min", where + " shape")
+                hi = _vec3(sh, "max", where + " shape")
+                if any(hi[k] < lo_[k] for k in range(3)):
+                    raise SceneError("%s: box max < min" % where)
+                _set(ob, "location", (lo_[0], -hi[2], lo_[1]))
+                # a zero extent would make a singular matrix; keep it tiny instead
+                _set(ob, "scale", (max(hi[0] - lo_[0], 1e-9), max(hi[2] - lo_[2], 1e-9),
+                                  max(hi[1] - lo_[1], 1e-9)))
+            elif st == "quad":
+                c0 = B(_vec3(sh, "corner", where + " shape"))
+                u = B(_vec3(sh, "edge_u", where + " shape"))
+                v = B(_vec3(sh, "edge_v", where + " shape"))
+                if u.cross(v).length < 1e-12:
+                    raise SceneError("%s: quad edges are parallel or zero" % where)
+                co = []
+                for p in (c0, c0 + u, c0 + u + v, c0 + v):
+                    co.extend(p)
+                me = ent["mesh"]
+                old = [0.0] * 12
+                me.vertices.foreach_get("co", old)
+                if any(abs(a - b) > 0 for a, b in zip(old, co)):
+                    me.vertices.foreach_set("co", co)
+                    me.update()
+            self._apply_material(ent, o.get("material", {}), where)
+
+    def _apply_material(self, ent, m, where):
+        where = where + " material"
+        color = _vec3(m, "color", where)
+        kd = _num(m, "diffuse", where, 1.0)
+        base = (kd * color[0], kd * color[1], kd * color[2], 1.0)
+        nodes = ent["nodes"]
+        if ent["kind"] == "lambertian":
+            _set(nodes["diffuse"].inputs["Color"], "default_value", base)
+            return
+        ks = _num(m, "specular", where, 0.0)
+        n = _num(m, "shininess", where, 10.0)
+        kr = _num(m, "reflection", where, 0.0)
+        kt = _num(m, "transmission", where, 0.0)
+        ior = _num(m, "ior", where, 1.5)
+        if n < 0:
+            raise SceneError("%s: shininess must be >= 0" % where)
+        p = nodes["principled"]
+        _set(p.inputs["Base Color"], "default_value", base)
+        _set(p.inputs["Specular"], "default_value", min(1.0, max(0.0, ks)))
+        _set(p.inputs["Roughness"], "default_value", (2.0 / (n + 2.0)) ** 0.25)
+        _set(p.inputs["Transmission"], "default_value", min(1.0, max(0.0, kt)))
+        _set(p.inputs["IOR"], "default_value", ior)
+        _set(nodes["mix"].inputs[0], "default_value", min(1.0, max(0.0, kr)))
+
+    # -- one request ------------------------------------------------------
+    def render(self, scene, output, seed):
+        t0 = time.perf_counter()
+        structure = structure_of(scene)
+        if structure != self.structure:
+            try:
+                self.build(scene, structure)
+            except Exception:
+                self.clear()
+                raise
+        try:
+            self.apply(scene)
+        except Exception:
+            # values may be half-applied; force a rebuild next time
+            self.structure = None
+            raise
+        if self.scene.cycles.seed != seed:
+            self.scene.cycles.seed = seed
+        t1 = time.perf_counter()
+        out = os.path.abspath(output)
+        d = os.path.dirname(out)
+        if d and not os.path.isdir(d):
+            os.makedirs(d, exist_ok=True)
+        bpy.ops.render.render(write_still=False)
+        t2 = time.perf_counter()
+        img = bpy.data.images.get("Render Result")
+        if img is None:
+            raise RuntimeError("Blender produced no render result")
+        img.save_render(out, scene=self.scene)
+        if TIMING:
+            log("timing build+apply %.4f render %.4f save %.4f" % (t1 - t0, t2 - t1, time.perf_counter() - t2))
+            log("datablocks objects %d meshes %d materials %d lights %d cameras %d images %d"
+                % (len(bpy.data.objects), len(bpy.data.meshes), len(bpy.data.materials),
+                   len(bpy.data.lights), len(bpy.data.cameras), len(bpy.data.images)))
+        if not os.path.isfile(out):
+            raise RuntimeError("Blender did not write %s" % out)
+
+
+def main():
+    opts = _parse_args(_args_after_dashdash())
+    _take_stdout(opts["quiet"])
+    try:
+        worker = Worker(opts["threads"])
+    except Exception as e:
+        traceback.print_exc()
+        send({"ready": False, "error": "worker setup failed: %s" % e})
+        sys.exit(1)
+    send({"ready": True, "renderer": "blender " + bpy.app.version_string})
+    stdin = sys.stdin.buffer
+    while True:
+        raw = stdin.readline()
+        if not raw:
+            break
+        line = raw.decode("utf-8", errors="replace").strip()
+        if not line:
+            continue
+        rid = None
+        try:
+            try:
+                req = json.loads(line)
+            except ValueError as e:
+                raise SceneError("malformed request line: %s" % e)
+            if not isinstance(req, dict):
+                raise SceneError("request must be a JSON object")
+            rid = req.get("id")
+            if "scene" not in req:
+                raise SceneError("request has no 'scene'")
+            output = req.get("output")
+            if not isinstance(output, str) or not output:
+                raise SceneError("request has no 'output' path")
+            seed = req.get("seed", 0)
+            if seed is None:
+                seed = 0
+            if isinstance(seed, bool) or not isinstance(seed, (int, float)):
+                raise SceneError("'seed' must be an integer")
+            seed = int(seed) % 2147483647  # Cycles seed is a non-negative int32
+            worker.render(req["scene"], output, seed)
+            send({"id": rid, "ok": True})
+        except SceneError as e:
+            send({"id": rid, "ok": False, "error": str(e)})
+        except Exception as e:
+            traceback.print_exc()
+            msg = str(e).strip() or type(e).__name__
+            send({"id": rid, "ok": False, "error": "%s: %s" % (type(e).__name__, msg)})
+    sys.stdout.flush()
+    sys.stderr.flush()
+    _PROTO.close()
+    # returning lets Blender quit normally, with exit code 0
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,55 @@
+//! The command line (DESIGN.md "Command line"): `demo`, `render`, `fit`.
+//! Each subcommand lives in its own file; this one parses and dispatches,
+//! and turns errors into one line and an exit code.
+
+mod demo;
+mod fit;
+mod progress;
+mod render;
+
+use clap::{Parser, Subcommand};
+
+#[derive(Parser, Debug)]
+#[command(name = "scenefit", version, about = "Recover a scene's optical parameters from a photograph by rendering in the loop")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// The paper's job on built-in data: fit hidden-truth targets of paper_box.json.
+    Demo(demo::DemoArgs),
+    /// Render a scene to an image.
+    Render(render::RenderArgs),
+    /// Fit a scene's free parameters to a target image.
+    Fit(fit::FitArgs),
+}
+
+/// Runs the command line; returns the process exit code.
+pub fn main() -> i32 {
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => {
+            let code = if e.use_stderr() { 2 } else { 0 };
+            let _ = e.print();
+            return code;
+        }
+    };
+    let result = match cli.command {
+        Command::Demo(a) => demo::run(a),
+        Command::Render(a) => render::run(a),
+        Command::Fit(a) => fit::run(a),
+    };
+    match result {
+        Ok(()) => 0,
+        Err(e) => {
+            eprintln!("error: {e}");
+            if e.is_user_error() {
+                2
+            } else {
+                1
+            }
+        }
+    }
+}

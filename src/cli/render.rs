@@ -1,0 +1,47 @@
+//! `scenefit render SCENE -o OUT.png [--renderer R] [--set P=V]... [--width W --height H]`
+
+use crate::error::{Error, Result};
+use crate::render::{from_spec, image_io, render_one};
+use crate::scene::{load_with, Override};
+use clap::Args;
+use std::path::PathBuf;
+
+#[derive(Args, Debug)]
+pub struct RenderArgs {
+    /// The scene file (JSON).
+    scene: PathBuf,
+    /// Where to write the image (.png or .bmp).
+    #[arg(short, long)]
+    output: PathBuf,
+    /// phong, povray, blender, mitsuba, cmd:TEMPLATE or worker:COMMAND.
+    #[arg(long, default_value = "phong")]
+    renderer: String,
+    /// Override a field: PARAM=JSON, e.g. lights.key.position=[1,2,3].
+    #[arg(long = "set", value_name = "PARAM=JSON")]
+    set: Vec<Override>,
+    /// Image width (overrides the scene's).
+    #[arg(long)]
+    width: Option<u32>,
+    /// Image height (overrides the scene's).
+    #[arg(long)]
+    height: Option<u32>,
+    /// Sampler seed for sampling renderers.
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+}
+
+pub fn run(a: RenderArgs) -> Result<()> {
+    let mut set = a.set.clone();
+    for (key, v) in [("image.width", a.width), ("image.height", a.height)] {
+        if let Some(v) = v {
+            if v == 0 {
+                return Err(Error::Usage(format!("--{}: expected a positive number of pixels", &key[6..])));
+            }
+            set.push(Override { path: key.into(), value: v.into() });
+        }
+    }
+    let scene = load_with(&a.scene, &set)?;
+    let renderer = from_spec(&a.renderer)?;
+    let img = render_one(renderer.as_ref(), &scene, a.seed)?;
+    image_io::write_image(&img, &a.output)
+}

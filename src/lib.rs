@@ -1,0 +1,12 @@
+//! scenefit: recover the optical parameters of a scene from a photograph by
+//! rendering in the loop. Data flows one way:
+//! scene -> parameter vector -> renderer -> image -> metric -> optimizer.
+
+pub mod cli;
+pub mod error;
+pub mod fit;
+pub mod math;
+pub mod metric;
+pub mod optimize;
+pub mod render;
+pub mod scene;

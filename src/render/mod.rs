@@ -1,0 +1,74 @@
+//! Renderers: the `Renderer` trait every backend implements, and the choice
+//! of backend from a name (`phong`, `povray`, `blender`, `mitsuba`,
+//! `cmd:TEMPLATE`, `worker:COMMAND`). Nothing outside this module knows
+//! which backend runs.
+
+pub mod phong;
+pub mod image_io;
+pub mod srgb;
+
+use crate::error::{Error, Result};
+use crate::scene::{ParamSpace, Scene};
+
+/// An 8-bit sRGB RGB image, as compared with the photograph.
+pub type Image = image::RgbImage;
+
+/// Why one render failed; it costs its candidate, not the run.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RenderFailure {
+    pub message: String,
+    /// What the renderer printed on stderr, kept for the log.
+    pub stderr: String,
+}
+
+impl std::fmt::Display for RenderFailure {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}", self.message)?;
+        if !self.stderr.trim().is_empty() {
+            write!(f, " (stderr: {})", self.stderr.trim())?;
+        }
+        Ok(())
+    }
+}
+
+pub type RenderResult = std::result::Result<Image, RenderFailure>;
+
+/// A backend. `session` prepares it to render many variants of one scene.
+pub trait Renderer: Send + Sync {
+    /// The name given on the command line, e.g. `phong`.
+    fn name(&self) -> String;
+
+    /// Prepares to render variants of `base` in which only the parameters
+    /// of `varying` change, with up to `jobs` renders at once.
+    fn session(&self, base: &Scene, varying: &ParamSpace, jobs: usize) -> Result<Box<dyn RenderSession>>;
+}
+
+/// A prepared renderer: renders batches of scene variants.
+pub trait RenderSession: Send {
+    /// The renderer and its version, for result.json.
+    fn describe(&self) -> String;
+
+    /// Renders every scene; `seed` seeds sampling backends, the same for the
+    /// whole batch so that candidates are not told apart by noise.
+    fn render_batch(&mut self, scenes: &[Scene], seed: u64) -> Vec<RenderResult>;
+}
+
+/// The backend named by `spec` (see the module doc).
+pub fn from_spec(spec: &str) -> Result<Box<dyn Renderer>> {
+    match spec {
+        "phong" => Ok(Box::new(phong::Phong)),
+        other => Err(Error::Usage(format!(
+            "--renderer {other}: unknown renderer; expected phong, povray, blender, mitsuba, cmd:TEMPLATE or worker:COMMAND"
+        ))),
+    }
+}
+
+/// Renders one scene once (for `scenefit render`).
+pub fn render_one(renderer: &dyn Renderer, scene: &Scene, seed: u64) -> Result<Image> {
+    let mut session = renderer.session(scene, &ParamSpace::default(), 1)?;
+    session
+        .render_batch(std::slice::from_ref(scene), seed)
+        .pop()
+        .unwrap_or_else(|| Err(RenderFailure { message: "no image".into(), stderr: String::new() }))
+        .map_err(|f| Error::Run(format!("{}: render failed: {f}", renderer.name())))
+}

@@ -1,0 +1,235 @@
+//! Ray intersection for the built-in tracer: spheres, infinite planes and
+//! parallelograms (quads); a box is six quads. Every primitive remembers the
+//! scene object it belongs to.
+
+use crate::math::V3;
+use crate::scene::{Scene, ShapeKind};
+
+/// Rays start this far off a surface so that they do not hit it again.
+pub const EPS: f64 = 1e-7;
+
+#[derive(Clone, Debug)]
+pub enum Prim {
+    Sphere { c: V3, r2: f64 },
+    Plane { p: V3, n: V3 },
+    /// Corner `o`, edges `u`, `v`, unit normal `n`; `w` = (u x v)/|u x v|^2
+    /// turns a point into its (alpha, beta) coordinates on the quad.
+    Quad { o: V3, u: V3, v: V3, n: V3, w: V3 },
+}
+
+/// A ray hit: distance along the ray, geometric normal (unit, not yet turned
+/// towards the ray) and the object hit.
+#[derive(Clone, Copy, Debug)]
+pub struct Hit {
+    pub t: f64,
+    pub n: V3,
+    pub object: u32,
+}
+
+/// A primitive that may block light from a given point.
+#[derive(Clone, Copy, Debug)]
+pub enum Occluder {
+    /// A sphere, as the cone of directions it covers from the point.
+    Cone { axis: V3, cos_max: f64, center_dist: f64, prim: u32 },
+    Prim(u32),
+}
+
+/// The scene's surfaces.
+pub struct Geometry {
+    pub prims: Vec<Prim>,
+    pub owner: Vec<u32>,
+}
+
+impl Geometry {
+    pub fn new(scene: &Scene) -> Geometry {
+        let mut prims = Vec::new();
+        let mut owner = Vec::new();
+        for (i, obj) in scene.objects.iter().enumerate() {
+            let s = &obj.shape;
+            let mut add = |p: Prim| {
+                prims.push(p);
+                owner.push(i as u32);
+            };
+            match s.kind {
+                ShapeKind::Sphere => {
+                    let r = s.radius.unwrap_or(1.0);
+                    add(Prim::Sphere { c: V3::from(s.center.unwrap_or_default()), r2: r * r });
+                }
+                ShapeKind::Plane => add(Prim::Plane {
+                    p: V3::from(s.point.unwrap_or_default()),
+                    n: V3::from(s.normal.unwrap_or([0.0, 1.0, 0.0])).normalized(),
+                }),
+                ShapeKind::Quad => add(quad(
+                    V3::from(s.corner.unwrap_or_default()),
+                    V3::from(s.edge_u.unwrap_or([1.0, 0.0, 0.0])),
+                    V3::from(s.edge_v.unwrap_or([0.0, 0.0, 1.0])),
+                )),
+                ShapeKind::Box => {
+                    let lo = V3::from(s.min.unwrap_or_default());
+                    let hi = V3::from(s.max.unwrap_or([1.0; 3]));
+                    let d = hi - lo;
+                    let (ex, ey, ez) = (V3::new(d.x, 0.0, 0.0), V3::new(0.0, d.y, 0.0), V3::new(0.0, 0.0, d.z));
+                    add(quad(lo, ex, ey));
+                    add(quad(lo + ez, ex, ey));
+                    add(quad(lo, ey, ez));
+                    add(quad(lo + ex, ey, ez));
+                    add(quad(lo, ez, ex));
+                    add(quad(lo + ey, ez, ex));
+                }
+            }
+        }
+        Geometry { prims, owner }
+    }
+
+    /// The nearest hit along the ray within (EPS, t_max).
+    pub fn intersect(&self, o: V3, d: V3, t_max: f64) -> Option<Hit> {
+        let mut best: Option<Hit> = None;
+        let mut t_best = t_max;
+        for (i, prim) in self.prims.iter().enumerate() {
+            if let Some((t, n)) = prim.intersect(o, d, t_best) {
+                t_best = t;
+                best = Some(Hit { t, n, object: self.owner[i] });
+            }
+        }
+        best
+    }
+
+    /// A possible occluder of point `p`, in the form fastest to test from there.
+    pub fn occluder(&self, prim: u32, p: V3) -> Occluder {
+        if let Prim::Sphere { c, r2 } = self.prims[prim as usize] {
+            let to = c - p;
+            let d2 = to.dot(to);
+            if d2 > r2 * (1.0 + 1e-9) {
+                let dist = d2.sqrt();
+                return Occluder::Cone { axis: to / dist, cos_max: (1.0 - r2 / d2).sqrt(), center_dist: dist, prim };
+            }
+        }
+        Occluder::Prim(prim)
+    }
+
+    /// True when any of `occluders` blocks the segment from `o` along unit
+    /// `d` before `t_max`.
+    #[inline]
+    pub fn occluded(&self, o: V3, d: V3, t_max: f64, occluders: &[Occluder]) -> bool {
+        occluders.iter().any(|occ| match *occ {
+            Occluder::Cone { axis, cos_max, center_dist, prim } => {
+                // Inside the cone the sphere sees, the ray hits it; the hit
+                // lies before the centre's distance, so a farther light is
+                // certainly blocked, a nearer one needs the exact test.
+                d.dot(axis) > cos_max && (t_max >= center_dist || self.prims[prim as usize].hits_before(o, d, t_max))
+            }
+            Occluder::Prim(i) => self.prims[i as usize].hits_before(o, d, t_max),
+        })
+    }
+}
+
+fn quad(o: V3, u: V3, v: V3) -> Prim {
+    let c = u.cross(v);
+    Prim::Quad { o, u, v, n: c.normalized(), w: c / c.dot(c) }
+}
+
+impl Prim {
+    /// Distance and unit normal of the nearest hit in (EPS, t_max).
+    #[inline]
+    pub fn intersect(&self, o: V3, d: V3, t_max: f64) -> Option<(f64, V3)> {
+        match *self {
+            Prim::Sphere { c, r2 } => {
+                let oc = o - c;
+                let b = oc.dot(d);
+                let cc = oc.dot(oc) - r2;
+                let disc = b * b - cc;
+                if disc < 0.0 {
+                    return None;
+                }
+                let sq = disc.sqrt();
+                let mut t = -b - sq;
+                if t <= EPS {
+                    t = -b + sq;
+                }
+                if t <= EPS || t >= t_max {
+                    return None;
+                }
+                let n = (o + d * t - c) / r2.sqrt();
+                Some((t, n))
+            }
+            Prim::Plane { p, n } => {
+                let denom = n.dot(d);
+                if denom.abs() < 1e-12 {
+                    return None;
+                }
+                let t = (p - o).dot(n) / denom;
+                (t > EPS && t < t_max).then_some((t, n))
+            }
+            Prim::Quad { o: q0, u, v, n, w } => {
+                let denom = n.dot(d);
+                if denom.abs() < 1e-12 {
+                    return None;
+                }
+                let t = (q0 - o).dot(n) / denom;
+                if t <= EPS || t >= t_max {
+                    return None;
+                }
+                let q = o + d * t - q0;
+                let a = w.dot(q.cross(v));
+                let b = w.dot(u.cross(q));
+                ((0.0..=1.0).contains(&a) && (0.0..=1.0).contains(&b)).then_some((t, n))
+            }
+        }
+    }
+
+    /// Shadow-ray test: any hit in (EPS, t_max)?
+    #[inline]
+    pub fn hits_before(&self, o: V3, d: V3, t_max: f64) -> bool {
+        match *self {
+            Prim::Sphere { c, r2 } => {
+                let oc = o - c;
+                let b = oc.dot(d);
+                let cc = oc.dot(oc) - r2;
+                let disc = b * b - cc;
+                if disc < 0.0 {
+                    return false;
+                }
+                let sq = disc.sqrt();
+                let (t0, t1) = (-b - sq, -b + sq);
+                (t0 > EPS && t0 < t_max) || (t1 > EPS && t1 < t_max)
+            }
+            _ => self.intersect(o, d, t_max).is_some(),
+        }
+    }
+
+    /// A conservative test: could this primitive block any segment from `p`
+    /// to a point of the axis-aligned box [lo, hi]? False only when it
+    /// certainly cannot.
+    pub fn may_block(&self, p: V3, lo: V3, hi: V3) -> bool {
+        match *self {
+            Prim::Sphere { c, r2 } => {
+                // The segments lie in the bounding box of p and [lo, hi].
+                let r = r2.sqrt();
+                (0..3).all(|a| {
+                    let (bl, bh) = (p.get(a).min(lo.get(a)), p.get(a).max(hi.get(a)));
+                    c.get(a) + r >= bl && c.get(a) - r <= bh
+                })
+            }
+            Prim::Plane { p: q, n } | Prim::Quad { o: q, n, .. } => {
+                // A segment crosses the plane only if its ends are on opposite sides.
+                let side_p = (p - q).dot(n);
+                if side_p.abs() < 1e-9 {
+                    return false; // p lies on the plane: the segment leaves it at once
+                }
+                corners(lo, hi).iter().any(|&k| (k - q).dot(n) * side_p <= 0.0)
+            }
+        }
+    }
+}
+
+fn corners(lo: V3, hi: V3) -> [V3; 8] {
+    let mut out = [lo; 8];
+    for (i, k) in out.iter_mut().enumerate() {
+        *k = V3::new(
+            if i & 1 == 0 { lo.x } else { hi.x },
+            if i & 2 == 0 { lo.y } else { hi.y },
+            if i & 4 == 0 { lo.z } else { hi.z },
+        );
+    }
+    out
+}

@@ -1,0 +1,76 @@
+//! The built-in Phong-Blinn ray tracer: perspective and orthographic
+//! cameras; spheres, planes, quads and boxes; point and directional lights
+//! with inverse-square or no falloff; hard shadows; ambient; normalised
+//! Blinn-Phong specular; mirror reflection and refraction to a depth limit.
+//! The shading equation is in `shade.rs` and docs/renderers.md.
+//!
+//! Reads from the scene: `camera`, `image`, `ambient`, `lights` (all but
+//! `radius`), `objects`, `render.antialias`, `render.max_depth`.
+//!
+//! Speed: what camera rays hit is traced once per session when no free
+//! parameter moves geometry, and a candidate only re-shades those hits.
+//! A batch renders its candidates in parallel; each render is sequential and
+//! deterministic.
+
+mod camera;
+mod geometry;
+mod paths;
+mod shade;
+
+use super::srgb::Encoder;
+use super::{Image, RenderResult, RenderSession, Renderer};
+use crate::error::{Error, Result};
+use crate::scene::{ParamSpace, Scene};
+use paths::{Paths, Variation};
+use rayon::prelude::*;
+use std::sync::Arc;
+
+/// The built-in tracer.
+pub struct Phong;
+
+impl Renderer for Phong {
+    fn name(&self) -> String {
+        "phong".into()
+    }
+
+    fn session(&self, base: &Scene, varying: &ParamSpace, jobs: usize) -> Result<Box<dyn RenderSession>> {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(jobs.max(1))
+            .build()
+            .map_err(|e| Error::Run(format!("phong: cannot start threads: {e}")))?;
+        let variation = Variation::new(base, varying);
+        let moves_geometry = varying.fields().iter().any(|f| f.moves_geometry());
+        let cached = if moves_geometry { None } else { Some(Arc::new(pool.install(|| Paths::build(base, &variation)))) };
+        Ok(Box::new(PhongSession { pool, variation, cached, encoder: Encoder::new() }))
+    }
+}
+
+struct PhongSession {
+    pool: rayon::ThreadPool,
+    variation: Variation,
+    cached: Option<Arc<Paths>>,
+    encoder: Encoder,
+}
+
+impl PhongSession {
+    fn render(&self, scene: &Scene) -> RenderResult {
+        let (w, h) = (scene.image.width, scene.image.height);
+        let mut buf = vec![0u8; (w * h * 3) as usize];
+        match &self.cached {
+            Some(paths) => shade::shade(paths, scene, &self.encoder, &mut buf),
+            None => shade::shade(&Paths::build(scene, &self.variation), scene, &self.encoder, &mut buf),
+        }
+        Ok(Image::from_raw(w, h, buf).expect("buffer sized to the image"))
+    }
+}
+
+impl RenderSession for PhongSession {
+    fn describe(&self) -> String {
+        format!("phong (scenefit {})", env!("CARGO_PKG_VERSION"))
+    }
+
+    fn render_batch(&mut self, scenes: &[Scene], _seed: u64) -> Vec<RenderResult> {
+        let this = &*self;
+        self.pool.install(|| scenes.par_iter().map(|s| this.render(s)).collect())
+    }
+}

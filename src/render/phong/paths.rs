@@ -1,0 +1,258 @@
+//! The part of a render that does not change between candidates: where
+//! camera rays hit (and, through mirrors and glass, where their reflected and
+//! refracted rays hit), and for each hit and light which surfaces could cast
+//! a shadow on it. Built once per run when only lights and materials are
+//! free; built per candidate when a free parameter moves geometry.
+
+use super::camera::CameraRays;
+use super::geometry::{Geometry, Occluder, EPS};
+use crate::math::V3;
+use crate::scene::field::{LightField, MaterialField};
+use crate::scene::{Field, LightKind, ParamSpace, Scene};
+use rayon::prelude::*;
+
+pub const NO_PARENT: u32 = u32::MAX;
+
+/// How a vertex was reached from its parent.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Via {
+    Camera,
+    Reflect,
+    Transmit,
+}
+
+/// One surface point seen by a camera ray or a ray it spawned.
+#[derive(Clone, Copy, Debug)]
+pub struct Vertex {
+    pub pixel: u32,
+    pub object: u32,
+    pub parent: u32,
+    pub via: Via,
+    pub p: V3,
+    /// Unit normal, turned towards the incoming ray.
+    pub n: V3,
+    /// Unit direction back along the incoming ray.
+    pub v: V3,
+}
+
+/// Shadowing of one vertex by one light.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Shadow {
+    /// Nothing can block it.
+    Lit,
+    /// Always blocked (a light that does not move).
+    Dark,
+    /// Test these primitives: `occluders[start..start+len]`.
+    Test { start: u32, len: u32 },
+}
+
+/// Everything a candidate's shading needs besides its lights and materials.
+pub struct Paths {
+    pub width: u32,
+    pub height: u32,
+    pub samples_per_pixel: u32,
+    pub verts: Vec<Vertex>,
+    /// `verts.len() * lights` entries, vertex-major.
+    pub shadow: Vec<Shadow>,
+    pub occluders: Vec<Occluder>,
+    pub geometry: Geometry,
+}
+
+/// What may change about each light between candidates.
+#[derive(Clone, Copy, Debug)]
+enum LightRange {
+    Fixed,
+    /// Position anywhere in the box [lo, hi].
+    Moving(V3, V3),
+    /// Direction free: anything may block it.
+    Turning,
+}
+
+/// What may vary about the scene, from the free parameters.
+pub struct Variation {
+    lights: Vec<LightRange>,
+    /// Objects whose reflection or transmission may become non-zero.
+    reflective: Vec<bool>,
+    transmissive: Vec<bool>,
+}
+
+impl Variation {
+    pub fn new(scene: &Scene, space: &ParamSpace) -> Variation {
+        let mut lights = vec![LightRange::Fixed; scene.lights.len()];
+        let mut reflective: Vec<bool> = scene.objects.iter().map(|o| o.material.reflection > 0.0).collect();
+        let mut transmissive: Vec<bool> = scene.objects.iter().map(|o| o.material.transmission > 0.0).collect();
+        for s in &space.specs {
+            match s.field {
+                Field::Light(i, LightField::Position) => {
+                    lights[i] = LightRange::Moving(V3::new(s.min[0], s.min[1], s.min[2]), V3::new(s.max[0], s.max[1], s.max[2]))
+                }
+                Field::Light(i, LightField::Direction) => lights[i] = LightRange::Turning,
+                Field::Material(i, MaterialField::Reflection) => reflective[i] |= s.max[0] > 0.0,
+                Field::Material(i, MaterialField::Transmission) => transmissive[i] |= s.max[0] > 0.0,
+                _ => {}
+            }
+        }
+        Variation { lights, reflective, transmissive }
+    }
+}
+
+impl Paths {
+    /// Traces the camera rays of `scene` (rows in parallel).
+    pub fn build(scene: &Scene, var: &Variation) -> Paths {
+        let geometry = Geometry::new(scene);
+        let cam = CameraRays::new(&scene.camera, scene.image);
+        let (w, h) = (scene.image.width, scene.image.height);
+        let aa = scene.render.antialias.max(1);
+        let rows: Vec<(Vec<Vertex>, Vec<Shadow>, Vec<Occluder>)> = (0..h)
+            .into_par_iter()
+            .map(|y| {
+                let mut t = Tracer { scene, geometry: &geometry, var, verts: Vec::new(), shadow: Vec::new(), occluders: Vec::new() };
+                for x in 0..w {
+                    for sy in 0..aa {
+                        for sx in 0..aa {
+                            let fx = x as f64 + (sx as f64 + 0.5) / aa as f64;
+                            let fy = y as f64 + (sy as f64 + 0.5) / aa as f64;
+                            let (o, d) = cam.ray(fx, fy);
+                            t.trace(y * w + x, o, d, NO_PARENT, Via::Camera, 0);
+                        }
+                    }
+                }
+                (t.verts, t.shadow, t.occluders)
+            })
+            .collect();
+        let mut paths = Paths { width: w, height: h, samples_per_pixel: aa * aa, verts: Vec::new(), shadow: Vec::new(), occluders: Vec::new(), geometry };
+        for (verts, shadow, occluders) in rows {
+            let base_v = paths.verts.len() as u32;
+            let base_o = paths.occluders.len() as u32;
+            paths.verts.extend(verts.into_iter().map(|mut v| {
+                if v.parent != NO_PARENT {
+                    v.parent += base_v;
+                }
+                v
+            }));
+            paths.shadow.extend(shadow.into_iter().map(|s| match s {
+                Shadow::Test { start, len } => Shadow::Test { start: start + base_o, len },
+                other => other,
+            }));
+            paths.occluders.extend(occluders);
+        }
+        paths
+    }
+}
+
+struct Tracer<'a> {
+    scene: &'a Scene,
+    geometry: &'a Geometry,
+    var: &'a Variation,
+    verts: Vec<Vertex>,
+    shadow: Vec<Shadow>,
+    occluders: Vec<Occluder>,
+}
+
+impl Tracer<'_> {
+    fn trace(&mut self, pixel: u32, o: V3, d: V3, parent: u32, via: Via, depth: u32) {
+        let Some(hit) = self.geometry.intersect(o, d, f64::INFINITY) else {
+            return;
+        };
+        let p = o + d * hit.t;
+        let entering = hit.n.dot(d) < 0.0;
+        let n = if entering { hit.n } else { -hit.n };
+        let index = self.verts.len() as u32;
+        self.verts.push(Vertex { pixel, object: hit.object, parent, via, p, n, v: -d });
+        for l in 0..self.scene.lights.len() {
+            let s = self.classify(p, n, hit.object, l);
+            self.shadow.push(s);
+        }
+        if depth >= self.scene.render.max_depth {
+            return;
+        }
+        let obj = hit.object as usize;
+        let cos_i = -n.dot(d);
+        let reflected = d + n * (2.0 * cos_i);
+        if self.var.reflective[obj] {
+            self.trace(pixel, p + n * EPS * 10.0, reflected, index, Via::Reflect, depth + 1);
+        }
+        if self.var.transmissive[obj] {
+            let ior = self.scene.objects[obj].material.ior;
+            let eta = if entering { 1.0 / ior } else { ior };
+            let k = 1.0 - eta * eta * (1.0 - cos_i * cos_i);
+            let (dir, start) = if k < 0.0 {
+                (reflected, p + n * EPS * 10.0) // total internal reflection
+            } else {
+                (d * eta + n * (eta * cos_i - k.sqrt()), p - n * EPS * 10.0)
+            };
+            self.trace(pixel, start, dir.normalized(), index, Via::Transmit, depth + 1);
+        }
+    }
+
+    /// Which primitives could shadow point `p` (normal `n`, on `object`) from light `l`.
+    fn classify(&mut self, p: V3, n: V3, object: u32, l: usize) -> Shadow {
+        let light = &self.scene.lights[l];
+        let g = self.geometry;
+        let others = |i: &usize| g.owner[*i] != object; // our shapes are convex: no self-shadowing
+        match (light.kind, self.var.lights[l]) {
+            (LightKind::Point, LightRange::Fixed) => {
+                let to = V3::from(light.position.unwrap_or_default()) - p;
+                let dist = to.length();
+                let d = to / dist;
+                if n.dot(d) <= 0.0 {
+                    return Shadow::Dark;
+                }
+                let o = p + n * EPS * 10.0;
+                let blocked = (0..g.prims.len()).filter(others).any(|i| g.prims[i].hits_before(o, d, dist));
+                if blocked {
+                    Shadow::Dark
+                } else {
+                    Shadow::Lit
+                }
+            }
+            (LightKind::Directional, LightRange::Fixed) => {
+                let d = V3::from(light.direction.unwrap_or([0.0, 1.0, 0.0])).normalized();
+                if n.dot(d) <= 0.0 {
+                    return Shadow::Dark;
+                }
+                let o = p + n * EPS * 10.0;
+                let blocked = (0..g.prims.len()).filter(others).any(|i| g.prims[i].hits_before(o, d, f64::INFINITY));
+                if blocked {
+                    Shadow::Dark
+                } else {
+                    Shadow::Lit
+                }
+            }
+            (_, LightRange::Moving(lo, hi)) => {
+                let start = self.occluders.len() as u32;
+                self.occluders.extend((0..g.prims.len()).filter(others).filter(|&i| g.prims[i].may_block(p, lo, hi)).map(|i| g.occluder(i as u32, p)));
+                let len = self.occluders.len() as u32 - start;
+                if len == 0 {
+                    Shadow::Lit
+                } else {
+                    Shadow::Test { start, len }
+                }
+            }
+            (_, LightRange::Turning) => {
+                let start = self.occluders.len() as u32;
+                self.occluders.extend((0..g.prims.len()).filter(others).map(|i| g.occluder(i as u32, p)));
+                let len = self.occluders.len() as u32 - start;
+                if len == 0 {
+                    Shadow::Lit
+                } else {
+                    Shadow::Test { start, len }
+                }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn count_candidates() {
+        let scene = crate::scene::load(std::path::Path::new("scenes/paper_box.json")).unwrap();
+        let space = crate::scene::ParamSpace::from_scene(&scene);
+        let p = super::Paths::build(&scene, &super::Variation::new(&scene, &space));
+        eprintln!("verts {} occluders {} prims {}", p.verts.len(), p.occluders.len(), p.geometry.prims.len());
+        let mut hist = std::collections::BTreeMap::new();
+        for s in &p.shadow { if let super::Shadow::Test{len,..} = s { *hist.entry(*len).or_insert(0) += 1; } else { *hist.entry(99).or_insert(0) += 1; } }
+        eprintln!("{hist:?}");
+    }
+}

@@ -1,0 +1,316 @@
+//! Numeric fields of a scene addressed by name: `lights.key.position`,
+//! `objects.ball.material.color`, `camera.fov_y_deg`, `ambient`. A path is
+//! resolved once against a scene into a `Field`, which then reads and writes
+//! that value in any copy of the scene without string matching.
+
+use super::types::{Scene, Vec3};
+
+/// A resolved numeric field of a scene.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Field {
+    Ambient,
+    Light(usize, LightField),
+    Material(usize, MaterialField),
+    Shape(usize, ShapeField),
+    Camera(CameraField),
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LightField {
+    Position,
+    Direction,
+    Color,
+    Intensity,
+    Radius,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MaterialField {
+    Color,
+    Diffuse,
+    Specular,
+    Shininess,
+    Reflection,
+    Transmission,
+    Ior,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ShapeField {
+    Center,
+    Radius,
+    Point,
+    Normal,
+    Corner,
+    EdgeU,
+    EdgeV,
+    Min,
+    Max,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CameraField {
+    Position,
+    LookAt,
+    Up,
+    FovY,
+    Height,
+}
+
+/// A field's value: a number or a 3-vector.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Value {
+    Scalar(f64),
+    Vector(Vec3),
+}
+
+impl Value {
+    pub fn to_json(self) -> serde_json::Value {
+        match self {
+            Value::Scalar(x) => serde_json::json!(x),
+            Value::Vector(v) => serde_json::json!(v),
+        }
+    }
+    pub fn components(&self) -> Vec<f64> {
+        match self {
+            Value::Scalar(x) => vec![*x],
+            Value::Vector(v) => v.to_vec(),
+        }
+    }
+}
+
+impl Field {
+    /// Resolves a dotted path against `scene`; the error says what was expected.
+    pub fn resolve(scene: &Scene, path: &str) -> Result<Field, String> {
+        let parts: Vec<&str> = path.split('.').collect();
+        match parts.as_slice() {
+            ["ambient"] => Ok(Field::Ambient),
+            ["lights", name, field] => {
+                let i = scene
+                    .light_index(name)
+                    .ok_or_else(|| format!("no light named \"{name}\" (lights: {})", names(scene.lights.iter().map(|l| &l.name))))?;
+                let f = match *field {
+                    "position" => LightField::Position,
+                    "direction" => LightField::Direction,
+                    "color" => LightField::Color,
+                    "intensity" => LightField::Intensity,
+                    "radius" => LightField::Radius,
+                    other => return Err(format!("a light has no numeric field \"{other}\" (expected position, direction, color, intensity or radius)")),
+                };
+                Ok(Field::Light(i, f))
+            }
+            ["objects", name, "material", field] => {
+                let i = object(scene, name)?;
+                let f = match *field {
+                    "color" => MaterialField::Color,
+                    "diffuse" => MaterialField::Diffuse,
+                    "specular" => MaterialField::Specular,
+                    "shininess" => MaterialField::Shininess,
+                    "reflection" => MaterialField::Reflection,
+                    "transmission" => MaterialField::Transmission,
+                    "ior" => MaterialField::Ior,
+                    other => return Err(format!("a material has no field \"{other}\" (expected color, diffuse, specular, shininess, reflection, transmission or ior)")),
+                };
+                Ok(Field::Material(i, f))
+            }
+            ["objects", name, "shape", field] => {
+                let i = object(scene, name)?;
+                let f = match *field {
+                    "center" => ShapeField::Center,
+                    "radius" => ShapeField::Radius,
+                    "point" => ShapeField::Point,
+                    "normal" => ShapeField::Normal,
+                    "corner" => ShapeField::Corner,
+                    "edge_u" => ShapeField::EdgeU,
+                    "edge_v" => ShapeField::EdgeV,
+                    "min" => ShapeField::Min,
+                    "max" => ShapeField::Max,
+                    other => return Err(format!("a shape has no numeric field \"{other}\"")),
+                };
+                let field = Field::Shape(i, f);
+                if field.get(scene).is_none() {
+                    return Err(format!("object \"{name}\" is a {:?} and has no \"{}\"", scene.objects[i].shape.kind, parts[3]).to_lowercase());
+                }
+                Ok(field)
+            }
+            ["camera", field] => {
+                let f = match *field {
+                    "position" => CameraField::Position,
+                    "look_at" => CameraField::LookAt,
+                    "up" => CameraField::Up,
+                    "fov_y_deg" => CameraField::FovY,
+                    "height" => CameraField::Height,
+                    other => return Err(format!("the camera has no numeric field \"{other}\"")),
+                };
+                let field = Field::Camera(f);
+                if field.get(scene).is_none() {
+                    return Err(format!("this camera has no \"{field}\"", field = parts[1]));
+                }
+                Ok(field)
+            }
+            _ => Err("expected ambient, lights.NAME.FIELD, objects.NAME.material.FIELD, objects.NAME.shape.FIELD or camera.FIELD".into()),
+        }
+    }
+
+    /// The current value, or None where the scene does not have it (a
+    /// directional light's position).
+    pub fn get(&self, scene: &Scene) -> Option<Value> {
+        use Value::{Scalar, Vector};
+        Some(match *self {
+            Field::Ambient => Vector(scene.ambient),
+            Field::Light(i, f) => {
+                let l = &scene.lights[i];
+                match f {
+                    LightField::Position => Vector(l.position?),
+                    LightField::Direction => Vector(l.direction?),
+                    LightField::Color => Vector(l.color),
+                    LightField::Intensity => Scalar(l.intensity),
+                    LightField::Radius => Scalar(l.radius),
+                }
+            }
+            Field::Material(i, f) => {
+                let m = &scene.objects[i].material;
+                match f {
+                    MaterialField::Color => Vector(m.color),
+                    MaterialField::Diffuse => Scalar(m.diffuse),
+                    MaterialField::Specular => Scalar(m.specular),
+                    MaterialField::Shininess => Scalar(m.shininess),
+                    MaterialField::Reflection => Scalar(m.reflection),
+                    MaterialField::Transmission => Scalar(m.transmission),
+                    MaterialField::Ior => Scalar(m.ior),
+                }
+            }
+            Field::Shape(i, f) => {
+                let s = &scene.objects[i].shape;
+                match f {
+                    ShapeField::Center => Vector(s.center?),
+                    ShapeField::Radius => Scalar(s.radius?),
+                    ShapeField::Point => Vector(s.point?),
+                    ShapeField::Normal => Vector(s.normal?),
+                    ShapeField::Corner => Vector(s.corner?),
+                    ShapeField::EdgeU => Vector(s.edge_u?),
+                    ShapeField::EdgeV => Vector(s.edge_v?),
+                    ShapeField::Min => Vector(s.min?),
+                    ShapeField::Max => Vector(s.max?),
+                }
+            }
+            Field::Camera(f) => {
+                let c = &scene.camera;
+                match f {
+                    CameraField::Position => Vector(c.position),
+                    CameraField::LookAt => Vector(c.look_at),
+                    CameraField::Up => Vector(c.up),
+                    CameraField::FovY => Scalar(c.fov_y_deg?),
+                    CameraField::Height => Scalar(c.height?),
+                }
+            }
+        })
+    }
+
+    /// Writes `value` into the field. The caller resolved the field against a
+    /// scene of the same structure, so the shapes match; a mismatch is ignored.
+    pub fn set(&self, scene: &mut Scene, value: Value) {
+        fn s(slot: &mut f64, v: Value) {
+            if let Value::Scalar(x) = v {
+                *slot = x;
+            }
+        }
+        fn v(slot: &mut [f64; 3], v: Value) {
+            if let Value::Vector(x) = v {
+                *slot = x;
+            }
+        }
+        fn ov(slot: &mut Option<[f64; 3]>, val: Value) {
+            if let (Some(slot), Value::Vector(x)) = (slot.as_mut(), val) {
+                *slot = x;
+            }
+        }
+        fn os(slot: &mut Option<f64>, val: Value) {
+            if let (Some(slot), Value::Scalar(x)) = (slot.as_mut(), val) {
+                *slot = x;
+            }
+        }
+        match *self {
+            Field::Ambient => v(&mut scene.ambient, value),
+            Field::Light(i, f) => {
+                let l = &mut scene.lights[i];
+                match f {
+                    LightField::Position => ov(&mut l.position, value),
+                    LightField::Direction => ov(&mut l.direction, value),
+                    LightField::Color => v(&mut l.color, value),
+                    LightField::Intensity => s(&mut l.intensity, value),
+                    LightField::Radius => s(&mut l.radius, value),
+                }
+            }
+            Field::Material(i, f) => {
+                let m = &mut scene.objects[i].material;
+                match f {
+                    MaterialField::Color => v(&mut m.color, value),
+                    MaterialField::Diffuse => s(&mut m.diffuse, value),
+                    MaterialField::Specular => s(&mut m.specular, value),
+                    MaterialField::Shininess => s(&mut m.shininess, value),
+                    MaterialField::Reflection => s(&mut m.reflection, value),
+                    MaterialField::Transmission => s(&mut m.transmission, value),
+                    MaterialField::Ior => s(&mut m.ior, value),
+                }
+            }
+            Field::Shape(i, f) => {
+                let sh = &mut scene.objects[i].shape;
+                match f {
+                    ShapeField::Center => ov(&mut sh.center, value),
+                    ShapeField::Radius => os(&mut sh.radius, value),
+                    ShapeField::Point => ov(&mut sh.point, value),
+                    ShapeField::Normal => ov(&mut sh.normal, value),
+                    ShapeField::Corner => ov(&mut sh.corner, value),
+                    ShapeField::EdgeU => ov(&mut sh.edge_u, value),
+                    ShapeField::EdgeV => ov(&mut sh.edge_v, value),
+                    ShapeField::Min => ov(&mut sh.min, value),
+                    ShapeField::Max => ov(&mut sh.max, value),
+                }
+            }
+            Field::Camera(f) => {
+                let c = &mut scene.camera;
+                match f {
+                    CameraField::Position => v(&mut c.position, value),
+                    CameraField::LookAt => v(&mut c.look_at, value),
+                    CameraField::Up => v(&mut c.up, value),
+                    CameraField::FovY => os(&mut c.fov_y_deg, value),
+                    CameraField::Height => os(&mut c.height, value),
+                }
+            }
+        }
+    }
+
+    /// True for colours (which may be searched in HSV).
+    pub fn is_color(&self) -> bool {
+        matches!(
+            self,
+            Field::Ambient | Field::Light(_, LightField::Color) | Field::Material(_, MaterialField::Color)
+        )
+    }
+
+    /// True when changing the field moves what camera rays hit: the camera,
+    /// a shape, or a refractive index. Renderers that cache ray hits across
+    /// candidates must recompute them when such a field varies.
+    pub fn moves_geometry(&self) -> bool {
+        matches!(
+            self,
+            Field::Camera(_) | Field::Shape(..) | Field::Material(_, MaterialField::Ior)
+        )
+    }
+}
+
+fn object(scene: &Scene, name: &str) -> Result<usize, String> {
+    scene
+        .object_index(name)
+        .ok_or_else(|| format!("no object named \"{name}\" (objects: {})", names(scene.objects.iter().map(|o| &o.name))))
+}
+
+fn names<'a>(it: impl Iterator<Item = &'a String>) -> String {
+    let v: Vec<&str> = it.map(|s| s.as_str()).collect();
+    if v.is_empty() {
+        "none".into()
+    } else {
+        v.join(", ")
+    }
+}

@@ -1,0 +1,15 @@
+//! The scene format (`scenefit-scene/1`, see DESIGN.md): typed structs,
+//! loading with validation, numeric fields addressed by name, and the
+//! parameter space that maps the `free` list to a search vector and back.
+
+pub mod color;
+pub mod field;
+pub mod load;
+pub mod params;
+pub mod types;
+pub mod validate;
+
+pub use field::{Field, Value};
+pub use load::{load, load_with, parse, Override};
+pub use params::{ParamSpace, ParamSpec};
+pub use types::*;

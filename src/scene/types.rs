@@ -1,0 +1,264 @@
+//! The typed scene: the structs the JSON format (`scenefit-scene/1`)
+//! deserialises into. Validation lives in `validate.rs`; these types only
+//! say what keys exist and what their defaults are.
+
+use serde::{Deserialize, Serialize};
+
+pub type Vec3 = [f64; 3];
+
+/// The format tag every scene file carries.
+pub const FORMAT: &str = "scenefit-scene/1";
+
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct Scene {
+    pub format: String,
+    pub image: ImageSize,
+    pub camera: Camera,
+    #[serde(default)]
+    pub ambient: Vec3,
+    #[serde(default)]
+    pub render: RenderSettings,
+    pub lights: Vec<Light>,
+    pub objects: Vec<Object>,
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub free: Vec<FreeParam>,
+}
+
+#[derive(Clone, Copy, Debug, Serialize, Deserialize, PartialEq, Eq)]
+#[serde(deny_unknown_fields)]
+pub struct ImageSize {
+    pub width: u32,
+    pub height: u32,
+}
+
+#[derive(Clone, Copy, Debug, Serialize, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "lowercase")]
+pub enum CameraKind {
+    Perspective,
+    Orthographic,
+}
+
+/// One struct for both camera kinds; `validate` checks that each kind has
+/// its own fields and none of the other's.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct Camera {
+    #[serde(rename = "type")]
+    pub kind: CameraKind,
+    pub position: Vec3,
+    pub look_at: Vec3,
+    #[serde(default = "default_up")]
+    pub up: Vec3,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fov_y_deg: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub height: Option<f64>,
+}
+
+fn default_up() -> Vec3 {
+    [0.0, 1.0, 0.0]
+}
+
+#[derive(Clone, Copy, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct RenderSettings {
+    /// Samples per pixel for sampling backends.
+    #[serde(default = "default_samples")]
+    pub samples: u32,
+    /// Trace indirect light (false: direct light only, as Phong does).
+    #[serde(default = "default_true")]
+    pub indirect: bool,
+    /// Supersampling of the built-in tracer: an n x n grid per pixel.
+    #[serde(default = "default_one")]
+    pub antialias: u32,
+    /// Recursion limit of mirror reflection and refraction.
+    #[serde(default = "default_depth")]
+    pub max_depth: u32,
+}
+
+impl Default for RenderSettings {
+    fn default() -> Self {
+        RenderSettings {
+            samples: default_samples(),
+            indirect: true,
+            antialias: 1,
+            max_depth: default_depth(),
+        }
+    }
+}
+
+fn default_samples() -> u32 {
+    16
+}
+fn default_true() -> bool {
+    true
+}
+fn default_one() -> u32 {
+    1
+}
+fn default_depth() -> u32 {
+    5
+}
+
+#[derive(Clone, Copy, Debug, Serialize, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "lowercase")]
+pub enum LightKind {
+    Point,
+    Directional,
+}
+
+#[derive(Clone, Copy, Debug, Serialize, Deserialize, PartialEq, Eq, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum Falloff {
+    #[default]
+    InverseSquare,
+    None,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct Light {
+    pub name: String,
+    #[serde(rename = "type")]
+    pub kind: LightKind,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub position: Option<Vec3>,
+    /// Towards the light (directional lights).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub direction: Option<Vec3>,
+    #[serde(default = "white")]
+    pub color: Vec3,
+    /// Point: radiant intensity, W/sr. Directional: irradiance, W/m^2.
+    pub intensity: f64,
+    #[serde(default)]
+    pub falloff: Falloff,
+    #[serde(default)]
+    pub radius: f64,
+}
+
+fn white() -> Vec3 {
+    [1.0, 1.0, 1.0]
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct Object {
+    pub name: String,
+    pub shape: Shape,
+    pub material: Material,
+}
+
+#[derive(Clone, Copy, Debug, Serialize, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "lowercase")]
+pub enum ShapeKind {
+    Sphere,
+    Plane,
+    Quad,
+    Box,
+}
+
+/// One struct for every shape kind; `validate` checks which fields each
+/// kind needs (sphere: center, radius; plane: point, normal; quad: corner,
+/// edge_u, edge_v; box: min, max).
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct Shape {
+    #[serde(rename = "type")]
+    pub kind: ShapeKind,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub center: Option<Vec3>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub radius: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub point: Option<Vec3>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub normal: Option<Vec3>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub corner: Option<Vec3>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub edge_u: Option<Vec3>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub edge_v: Option<Vec3>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub min: Option<Vec3>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max: Option<Vec3>,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct Material {
+    /// Linear RGB albedo.
+    pub color: Vec3,
+    #[serde(default = "one")]
+    pub diffuse: f64,
+    #[serde(default)]
+    pub specular: f64,
+    #[serde(default = "default_shininess")]
+    pub shininess: f64,
+    #[serde(default)]
+    pub reflection: f64,
+    #[serde(default)]
+    pub transmission: f64,
+    #[serde(default = "default_ior")]
+    pub ior: f64,
+}
+
+fn one() -> f64 {
+    1.0
+}
+fn default_shininess() -> f64 {
+    10.0
+}
+fn default_ior() -> f64 {
+    1.5
+}
+
+impl Material {
+    /// Diffuse only: the same Lambertian BSDF in every backend.
+    pub fn is_lambertian(&self) -> bool {
+        self.specular == 0.0 && self.reflection == 0.0 && self.transmission == 0.0
+    }
+}
+
+/// A bound of a free parameter: a number, or one per component.
+#[derive(Clone, Copy, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(untagged)]
+pub enum Bound {
+    Scalar(f64),
+    Vector(Vec3),
+}
+
+#[derive(Clone, Copy, Debug, Serialize, Deserialize, PartialEq, Eq, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum ColorSpace {
+    #[default]
+    Rgb,
+    Hsv,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct FreeParam {
+    pub param: String,
+    pub min: Bound,
+    pub max: Bound,
+    #[serde(default, skip_serializing_if = "is_rgb")]
+    pub space: ColorSpace,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub phase: Option<u32>,
+}
+
+fn is_rgb(space: &ColorSpace) -> bool {
+    *space == ColorSpace::Rgb
+}
+
+impl Scene {
+    pub fn light_index(&self, name: &str) -> Option<usize> {
+        self.lights.iter().position(|l| l.name == name)
+    }
+    pub fn object_index(&self, name: &str) -> Option<usize> {
+        self.objects.iter().position(|o| o.name == name)
+    }
+}

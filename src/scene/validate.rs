@@ -1,0 +1,270 @@
+//! Checks a parsed scene for values the types cannot rule out: missing or
+//! misplaced fields per kind, negative radii, a degenerate camera, duplicate
+//! names, free parameters that name nothing or have bad bounds. Every error
+//! names the key path and what was expected.
+
+use super::field::{Field, Value};
+use super::types::*;
+use crate::error::{Error, Result};
+use crate::math::V3;
+
+/// Validates `scene`, read from `file` (for messages).
+pub fn validate(scene: &Scene, file: &str) -> Result<()> {
+    let err = |key: String, msg: String| Err(Error::invalid(file, key, msg));
+    if scene.format != FORMAT {
+        return err("format".into(), format!("expected \"{FORMAT}\", got \"{}\"", scene.format));
+    }
+    if scene.image.width == 0 || scene.image.height == 0 || scene.image.width > 16384 || scene.image.height > 16384 {
+        return err("image".into(), "expected width and height between 1 and 16384".into());
+    }
+    if scene.render.samples == 0 {
+        return err("render.samples".into(), "expected at least 1".into());
+    }
+    if !(1..=16).contains(&scene.render.antialias) {
+        return err("render.antialias".into(), "expected 1 to 16".into());
+    }
+    non_negative3(file, "ambient", scene.ambient)?;
+    camera(&scene.camera, file)?;
+    let mut seen = std::collections::HashSet::new();
+    for (i, l) in scene.lights.iter().enumerate() {
+        let at = format!("lights[{i}]");
+        if !seen.insert(&l.name) {
+            return err(format!("{at}.name"), format!("duplicate light name \"{}\"", l.name));
+        }
+        light(l, file, &at)?;
+    }
+    let mut seen = std::collections::HashSet::new();
+    for (i, o) in scene.objects.iter().enumerate() {
+        let at = format!("objects[{i}]");
+        if !seen.insert(&o.name) {
+            return err(format!("{at}.name"), format!("duplicate object name \"{}\"", o.name));
+        }
+        shape(&o.shape, file, &format!("{at}.shape"))?;
+        material(&o.material, file, &format!("{at}.material"))?;
+    }
+    let mut seen = std::collections::HashSet::new();
+    for (i, f) in scene.free.iter().enumerate() {
+        let at = format!("free[{i}]");
+        if !seen.insert(&f.param) {
+            return err(format!("{at}.param"), format!("\"{}\" is free twice", f.param));
+        }
+        free(scene, f, file, &at)?;
+    }
+    Ok(())
+}
+
+fn finite3(v: Vec3) -> bool {
+    v.iter().all(|x| x.is_finite())
+}
+
+fn non_negative3(file: &str, key: &str, v: Vec3) -> Result<()> {
+    if !finite3(v) || v.iter().any(|&x| x < 0.0) {
+        return Err(Error::invalid(file, key, format!("expected three non-negative numbers, got {v:?}")));
+    }
+    Ok(())
+}
+
+fn non_negative(file: &str, key: &str, x: f64) -> Result<()> {
+    if !x.is_finite() || x < 0.0 {
+        return Err(Error::invalid(file, key, format!("expected a non-negative number, got {x}")));
+    }
+    Ok(())
+}
+
+fn positive(file: &str, key: &str, x: f64) -> Result<()> {
+    if !x.is_finite() || x <= 0.0 {
+        return Err(Error::invalid(file, key, format!("expected a positive number, got {x}")));
+    }
+    Ok(())
+}
+
+fn nonzero3(file: &str, key: &str, v: Vec3) -> Result<()> {
+    if !finite3(v) || V3::from(v).length() < 1e-12 {
+        return Err(Error::invalid(file, key, format!("expected a non-zero vector, got {v:?}")));
+    }
+    Ok(())
+}
+
+fn required<T: Copy>(file: &str, key: &str, v: Option<T>, what: &str) -> Result<T> {
+    v.ok_or_else(|| Error::invalid(file, key, format!("missing; {what}")))
+}
+
+fn forbidden<T>(file: &str, key: &str, v: &Option<T>, what: &str) -> Result<()> {
+    if v.is_some() {
+        return Err(Error::invalid(file, key, format!("not used by {what}")));
+    }
+    Ok(())
+}
+
+fn camera(c: &Camera, file: &str) -> Result<()> {
+    if !finite3(c.position) || !finite3(c.look_at) {
+        return Err(Error::invalid(file, "camera.position", "expected finite numbers"));
+    }
+    let view = V3::from(c.look_at) - V3::from(c.position);
+    if view.length() < 1e-9 {
+        return Err(Error::invalid(file, "camera.look_at", "must differ from camera.position"));
+    }
+    nonzero3(file, "camera.up", c.up)?;
+    let up = V3::from(c.up).normalized();
+    if view.normalized().cross(up).length() < 1e-6 {
+        return Err(Error::invalid(
+            file,
+            "camera.up",
+            "is parallel to the view direction (look_at - position); expected a vector that is not",
+        ));
+    }
+    match c.kind {
+        CameraKind::Perspective => {
+            let fov = required(file, "camera.fov_y_deg", c.fov_y_deg, "a perspective camera needs fov_y_deg")?;
+            if !(fov > 0.0 && fov < 180.0) {
+                return Err(Error::invalid(file, "camera.fov_y_deg", format!("expected a number in (0, 180), got {fov}")));
+            }
+            forbidden(file, "camera.height", &c.height, "a perspective camera (use fov_y_deg)")
+        }
+        CameraKind::Orthographic => {
+            let h = required(file, "camera.height", c.height, "an orthographic camera needs height (metres)")?;
+            positive(file, "camera.height", h)?;
+            forbidden(file, "camera.fov_y_deg", &c.fov_y_deg, "an orthographic camera (use height)")
+        }
+    }
+}
+
+fn light(l: &Light, file: &str, at: &str) -> Result<()> {
+    non_negative3(file, &format!("{at}.color"), l.color)?;
+    non_negative(file, &format!("{at}.intensity"), l.intensity)?;
+    non_negative(file, &format!("{at}.radius"), l.radius)?;
+    match l.kind {
+        LightKind::Point => {
+            let p = required(file, &format!("{at}.position"), l.position, "a point light needs a position")?;
+            if !finite3(p) {
+                return Err(Error::invalid(file, format!("{at}.position"), "expected finite numbers"));
+            }
+            forbidden(file, &format!("{at}.direction"), &l.direction, "a point light (use position)")
+        }
+        LightKind::Directional => {
+            let d = required(file, &format!("{at}.direction"), l.direction, "a directional light needs a direction (towards the light)")?;
+            nonzero3(file, &format!("{at}.direction"), d)?;
+            forbidden(file, &format!("{at}.position"), &l.position, "a directional light (use direction)")
+        }
+    }
+}
+
+fn shape(s: &Shape, file: &str, at: &str) -> Result<()> {
+    let key = |k: &str| format!("{at}.{k}");
+    let all: [(&str, bool); 9] = [
+        ("center", s.center.is_some()),
+        ("radius", s.radius.is_some()),
+        ("point", s.point.is_some()),
+        ("normal", s.normal.is_some()),
+        ("corner", s.corner.is_some()),
+        ("edge_u", s.edge_u.is_some()),
+        ("edge_v", s.edge_v.is_some()),
+        ("min", s.min.is_some()),
+        ("max", s.max.is_some()),
+    ];
+    let (kind, wanted): (&str, &[&str]) = match s.kind {
+        ShapeKind::Sphere => ("a sphere", &["center", "radius"]),
+        ShapeKind::Plane => ("a plane", &["point", "normal"]),
+        ShapeKind::Quad => ("a quad", &["corner", "edge_u", "edge_v"]),
+        ShapeKind::Box => ("a box", &["min", "max"]),
+    };
+    for (name, present) in all {
+        let needed = wanted.contains(&name);
+        if needed && !present {
+            return Err(Error::invalid(file, key(name), format!("missing; {kind} needs {}", wanted.join(", "))));
+        }
+        if !needed && present {
+            return Err(Error::invalid(file, key(name), format!("not used by {kind} (it takes {})", wanted.join(", "))));
+        }
+    }
+    let finite = |k: &str, v: Option<Vec3>| -> Result<()> {
+        match v {
+            Some(v) if !finite3(v) => Err(Error::invalid(file, key(k), "expected finite numbers")),
+            _ => Ok(()),
+        }
+    };
+    for (k, v) in [("center", s.center), ("point", s.point), ("corner", s.corner), ("min", s.min), ("max", s.max)] {
+        finite(k, v)?;
+    }
+    match s.kind {
+        ShapeKind::Sphere => positive(file, &key("radius"), s.radius.unwrap_or(0.0)),
+        ShapeKind::Plane => nonzero3(file, &key("normal"), s.normal.unwrap_or_default()),
+        ShapeKind::Quad => {
+            let (u, v) = (s.edge_u.unwrap_or_default(), s.edge_v.unwrap_or_default());
+            nonzero3(file, &key("edge_u"), u)?;
+            nonzero3(file, &key("edge_v"), v)?;
+            if V3::from(u).cross(V3::from(v)).length() < 1e-12 {
+                return Err(Error::invalid(file, key("edge_v"), "is parallel to edge_u; expected two edges that span a parallelogram"));
+            }
+            Ok(())
+        }
+        ShapeKind::Box => {
+            let (lo, hi) = (s.min.unwrap_or_default(), s.max.unwrap_or_default());
+            if (0..3).any(|a| lo[a] >= hi[a]) {
+                return Err(Error::invalid(file, key("max"), format!("expected every component above min {lo:?}, got {hi:?}")));
+            }
+            Ok(())
+        }
+    }
+}
+
+fn material(m: &Material, file: &str, at: &str) -> Result<()> {
+    let key = |k: &str| format!("{at}.{k}");
+    non_negative3(file, &key("color"), m.color)?;
+    non_negative(file, &key("diffuse"), m.diffuse)?;
+    non_negative(file, &key("specular"), m.specular)?;
+    positive(file, &key("shininess"), m.shininess)?;
+    non_negative(file, &key("reflection"), m.reflection)?;
+    non_negative(file, &key("transmission"), m.transmission)?;
+    positive(file, &key("ior"), m.ior)
+}
+
+fn free(scene: &Scene, f: &FreeParam, file: &str, at: &str) -> Result<()> {
+    let field = Field::resolve(scene, &f.param).map_err(|m| Error::invalid(file, format!("{at}.param"), format!("\"{}\": {m}", f.param)))?;
+    let current = field.get(scene).ok_or_else(|| Error::invalid(file, format!("{at}.param"), format!("\"{}\" is not set in this scene", f.param)))?;
+    let n = current.components().len();
+    let expand = |b: Bound, which: &str| -> Result<Vec<f64>> {
+        match (b, n) {
+            (Bound::Scalar(x), 1) => Ok(vec![x]),
+            (Bound::Scalar(x), 3) => Ok(vec![x; 3]),
+            (Bound::Vector(v), 3) => Ok(v.to_vec()),
+            (Bound::Vector(_), _) => Err(Error::invalid(file, format!("{at}.{which}"), format!("\"{}\" is a number; expected a number, not a vector", f.param))),
+            _ => unreachable!("fields are scalars or 3-vectors"),
+        }
+    };
+    let lo = expand(f.min, "min")?;
+    let hi = expand(f.max, "max")?;
+    for c in 0..n {
+        if !lo[c].is_finite() || !hi[c].is_finite() {
+            return Err(Error::invalid(file, format!("{at}.min"), "expected finite bounds"));
+        }
+        if lo[c] > hi[c] {
+            return Err(Error::invalid(file, format!("{at}.max"), format!("expected max >= min, got min {:?} and max {:?}", lo, hi)));
+        }
+    }
+    if f.space == ColorSpace::Hsv {
+        if !field.is_color() {
+            return Err(Error::invalid(file, format!("{at}.space"), format!("\"hsv\" is for colours; \"{}\" is not one", f.param)));
+        }
+        if lo.iter().chain(hi.iter()).any(|&x| !(0.0..=1.0).contains(&x)) {
+            return Err(Error::invalid(file, format!("{at}.min"), "HSV bounds must lie in [0, 1]"));
+        }
+    }
+    if field.is_color() && f.space == ColorSpace::Rgb && lo.iter().any(|&x| x < 0.0) {
+        return Err(Error::invalid(file, format!("{at}.min"), "colours cannot go below 0"));
+    }
+    if f.phase == Some(0) {
+        return Err(Error::invalid(file, format!("{at}.phase"), "expected 1 or more"));
+    }
+    if let Value::Scalar(_) = current {
+        let physical_min = match field {
+            Field::Material(_, super::field::MaterialField::Shininess | super::field::MaterialField::Ior) => f64::MIN_POSITIVE,
+            Field::Camera(_) | Field::Shape(..) => f64::MIN_POSITIVE,
+            _ => 0.0,
+        };
+        if lo[0] < physical_min {
+            return Err(Error::invalid(file, format!("{at}.min"), format!("\"{}\" cannot go below {}", f.param, if physical_min > 0.0 { "or to 0" } else { "0" })));
+        }
+    }
+    Ok(())
+}
