@@ -38,6 +38,12 @@ pub trait Renderer: Send + Sync {
     /// The name given on the command line, e.g. `phong`.
     fn name(&self) -> String;
 
+    /// Renders at once when the user does not say (`--jobs`): the number of
+    /// cores for CPU-bound renderers; more for those that mostly wait.
+    fn default_jobs(&self) -> usize {
+        std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1)
+    }
+
     /// Prepares to render variants of `base` in which only the parameters
     /// of `varying` change, with up to `jobs` renders at once.
     fn session(&self, base: &Scene, varying: &ParamSpace, jobs: usize) -> Result<Box<dyn RenderSession>>;
