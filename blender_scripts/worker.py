@@ -10,8 +10,10 @@ Protocol
 At start the script keeps a private duplicate of fd 1 for protocol messages
 and points fd 1 at fd 2 (``--quiet``: at /dev/null), so that everything
 Blender/Cycles print after that goes to stderr.  NOTE: Blender itself prints
-a banner ("Blender 3.4.1" and an empty line) on stdout *before* this script
-runs; a client must skip non-JSON lines until the ready line.
+a banner line ("Blender 3.4.1") on stdout *before* this script runs; a
+client must skip non-JSON lines until the ready line.  Options: --threads N
+(default 1, 0 = automatic), --quiet.  SCENEFIT_WORKER_TIMING=1 in the
+environment logs per-request timings to stderr.
 
     -> {"ready": true, "renderer": "blender 3.4.1"}
     <- {"id": 17, "scene": {...}, "output": "/path/17.png", "seed": 5}

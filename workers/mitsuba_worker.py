@@ -75,8 +75,8 @@ materials (d = diffuse, c = color, ks = specular, n = shininess, kr = reflection
   ks = kr = kt = 0 -> ``twosided`` ``diffuse`` with reflectance d*c (Lambertian;
                       not clamped to 1, negative values become 0).
   otherwise        -> ``principled``: base_color d*c, metallic 0,
-                      roughness (2/(n+2))^(1/4), specular min(1, ks/0.08) (F0 = ks up to
-                      0.08); kt > 0: spec_trans = kt and eta = ior (Mitsuba then ignores
+                      roughness (2/(n+2))^(1/4), specular level min(1, ks) (F0 = 0.08*ks, so
+                      ks 0.5 <-> F0 0.04, as Blender); kt > 0: spec_trans = kt and eta = ior (Mitsuba then ignores
                       `specular`: F0 follows from ior).
                       kr > 0: ``blendbsdf`` (weight kr) of that and a white perfect
                       mirror (``conductor``, material none).
@@ -235,7 +235,7 @@ def material_plan(m, where):
         "kind": ("principled", kr > 0.0, kt > 0.0),
         "albedo": albedo,
         "roughness": min(max((2.0 / (n + 2.0)) ** 0.25, 0.0), 1.0),
-        "specular": min(max(ks / 0.08, 0.0), 1.0),
+        "specular": min(max(ks, 0.0), 1.0),
         "spec_trans": min(max(kt, 0.0), 1.0),
         "eta": ior if ior != 1.0 else 1.0001,
         "mirror": min(max(kr, 0.0), 1.0),
