@@ -9,7 +9,12 @@ use scenefit::scene::{load, ParamSpace, Scene};
 use std::path::Path;
 
 fn generation(scene_file: &str) -> (Box<dyn RenderSession>, Vec<Scene>) {
-    let scene = load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes").join(scene_file)).expect("example scene loads");
+    let scene = load(
+        &Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("scenes")
+            .join(scene_file),
+    )
+    .expect("example scene loads");
     let space = ParamSpace::from_scene(&scene);
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
     let scenes: Vec<Scene> = (0..80)
@@ -18,8 +23,13 @@ fn generation(scene_file: &str) -> (Box<dyn RenderSession>, Vec<Scene>) {
             space.scene_at(&scene, &u)
         })
         .collect();
-    let jobs = std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1);
-    let session = from_spec("phong").unwrap().session(&scene, &space, jobs).unwrap();
+    let jobs = std::thread::available_parallelism()
+        .map(|n| n.get())
+        .unwrap_or(1);
+    let session = from_spec("phong")
+        .unwrap()
+        .session(&scene, &space, jobs)
+        .unwrap();
     (session, scenes)
 }
 

@@ -33,7 +33,11 @@ pub enum Error {
 
 impl Error {
     /// An error about a key in an input file.
-    pub fn invalid(file: impl Into<String>, key: impl Into<String>, message: impl Into<String>) -> Self {
+    pub fn invalid(
+        file: impl Into<String>,
+        key: impl Into<String>,
+        message: impl Into<String>,
+    ) -> Self {
         Error::Invalid {
             file: file.into(),
             key: key.into(),

@@ -10,7 +10,11 @@ pub struct V3 {
 }
 
 impl V3 {
-    pub const ZERO: V3 = V3 { x: 0.0, y: 0.0, z: 0.0 };
+    pub const ZERO: V3 = V3 {
+        x: 0.0,
+        y: 0.0,
+        z: 0.0,
+    };
 
     pub const fn new(x: f64, y: f64, z: f64) -> V3 {
         V3 { x, y, z }
@@ -19,7 +23,11 @@ impl V3 {
         self.x * o.x + self.y * o.y + self.z * o.z
     }
     pub fn cross(self, o: V3) -> V3 {
-        V3::new(self.y * o.z - self.z * o.y, self.z * o.x - self.x * o.z, self.x * o.y - self.y * o.x)
+        V3::new(
+            self.y * o.z - self.z * o.y,
+            self.z * o.x - self.x * o.z,
+            self.x * o.y - self.y * o.x,
+        )
     }
     pub fn length(self) -> f64 {
         self.dot(self).sqrt()

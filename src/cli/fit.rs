@@ -54,12 +54,27 @@ impl SearchArgs {
         }
         if let Some(d) = self.target_deviation {
             if !(d >= 0.0) {
-                return Err(Error::Usage(format!("--target-deviation: expected a percentage >= 0, got {d}")));
+                return Err(Error::Usage(format!(
+                    "--target-deviation: expected a percentage >= 0, got {d}"
+                )));
             }
         }
-        let de = DeConfig { population: self.population, f: self.f, cr: self.cr, strategy: self.strategy, seed: self.seed };
+        let de = DeConfig {
+            population: self.population,
+            f: self.f,
+            cr: self.cr,
+            strategy: self.strategy,
+            seed: self.seed,
+        };
         de.validate().map_err(|e| Error::Usage(format!("{e}")))?;
-        let mut c = FitConfig { de, generations: self.generations, phase_generations: self.phase_generations.clone(), target_deviation: self.target_deviation, stagnation: self.stagnation, ..FitConfig::default() };
+        let mut c = FitConfig {
+            de,
+            generations: self.generations,
+            phase_generations: self.phase_generations.clone(),
+            target_deviation: self.target_deviation,
+            stagnation: self.stagnation,
+            ..FitConfig::default()
+        };
         if let Some(j) = self.jobs {
             c.jobs = j;
         }
@@ -99,14 +114,29 @@ pub struct FitArgs {
 pub fn run(a: FitArgs) -> Result<()> {
     let scene = load_with(&a.scene, &a.set)?;
     let image = image_io::read_target(&a.target, scene.image.width, scene.image.height)?;
-    let mask = a.mask.as_ref().map(|m| Mask::load(m, scene.image.width, scene.image.height)).transpose()?;
+    let mask = a
+        .mask
+        .as_ref()
+        .map(|m| Mask::load(m, scene.image.width, scene.image.height))
+        .transpose()?;
     let renderer = from_spec(&a.renderer)?;
     let mut config = a.search.config()?;
     config.resume = a.resume;
     config.interrupt = Some(interrupt_flag());
-    let target = FitTarget { image, mask, path: Some(a.target.clone()) };
+    let target = FitTarget {
+        image,
+        mask,
+        path: Some(a.target.clone()),
+    };
     let mut progress = Progress::new(a.quiet);
-    let result = fit::run(&scene, &target, renderer.as_ref(), &config, &a.output, &mut progress)?;
+    let result = fit::run(
+        &scene,
+        &target,
+        renderer.as_ref(),
+        &config,
+        &a.output,
+        &mut progress,
+    )?;
     progress.finish();
     if !a.quiet {
         let d = result.deviation;

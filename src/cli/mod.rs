@@ -10,7 +10,11 @@ mod render;
 use clap::{Parser, Subcommand};
 
 #[derive(Parser, Debug)]
-#[command(name = "scenefit", version, about = "Recover a scene's optical parameters from a photograph by rendering in the loop")]
+#[command(
+    name = "scenefit",
+    version,
+    about = "Recover a scene's optical parameters from a photograph by rendering in the loop"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,

@@ -39,14 +39,20 @@ impl Observer for Progress {
         for f in r.failures.iter().take(3) {
             eprintln!("render failed: {f}");
         }
-        let msg = format!("deviation {:.3}% ({:.0} renders/s, phase {})", r.best.average, r.renders_per_second, r.phase);
+        let msg = format!(
+            "deviation {:.3}% ({:.0} renders/s, phase {})",
+            r.best.average, r.renders_per_second, r.phase
+        );
         match &self.bar {
             Some(b) => {
                 b.set_length(r.total_generations as u64);
                 b.set_position(r.generation as u64);
                 b.set_message(msg);
             }
-            None if r.generation % 10 == 0 => eprintln!("generation {} of {}: {msg}, {} renders, {:.1} s", r.generation, r.total_generations, r.evaluations, r.elapsed),
+            None if r.generation % 10 == 0 => eprintln!(
+                "generation {} of {}: {msg}, {} renders, {:.1} s",
+                r.generation, r.total_generations, r.evaluations, r.elapsed
+            ),
             None => {}
         }
     }

@@ -35,9 +35,15 @@ pub fn run(a: RenderArgs) -> Result<()> {
     for (key, v) in [("image.width", a.width), ("image.height", a.height)] {
         if let Some(v) = v {
             if v == 0 {
-                return Err(Error::Usage(format!("--{}: expected a positive number of pixels", &key[6..])));
+                return Err(Error::Usage(format!(
+                    "--{}: expected a positive number of pixels",
+                    &key[6..]
+                )));
             }
-            set.push(Override { path: key.into(), value: v.into() });
+            set.push(Override {
+                path: key.into(),
+                value: v.into(),
+            });
         }
     }
     let scene = load_with(&a.scene, &set)?;

@@ -53,25 +53,56 @@ impl Checkpoint {
     pub fn load(dir: &Path, config: &FitConfig, space: &ParamSpace) -> Result<Checkpoint> {
         let path = dir.join(FILE);
         let text = std::fs::read_to_string(&path).map_err(|e| {
-            Error::Usage(format!("--resume: cannot read {} ({e}); run without --resume to start afresh", path.display()))
+            Error::Usage(format!(
+                "--resume: cannot read {} ({e}); run without --resume to start afresh",
+                path.display()
+            ))
         })?;
         let file = path.display().to_string();
-        let c: Checkpoint = serde_json::from_str(&text).map_err(|e| Error::invalid(&file, "(checkpoint)", format!("not a scenefit checkpoint ({e})")))?;
+        let c: Checkpoint = serde_json::from_str(&text).map_err(|e| {
+            Error::invalid(
+                &file,
+                "(checkpoint)",
+                format!("not a scenefit checkpoint ({e})"),
+            )
+        })?;
         if c.format != FORMAT {
-            return Err(Error::invalid(&file, "format", format!("expected \"{FORMAT}\"")));
+            return Err(Error::invalid(
+                &file,
+                "format",
+                format!("expected \"{FORMAT}\""),
+            ));
         }
-        let mismatch = |what: &str, was: String, now: String| Error::Usage(format!("--resume: {file} was written with {what} {was}, this run has {now}; pass the same options"));
+        let mismatch = |what: &str, was: String, now: String| {
+            Error::Usage(format!("--resume: {file} was written with {what} {was}, this run has {now}; pass the same options"))
+        };
         if c.population != config.de.population {
-            return Err(mismatch("--population", c.population.to_string(), config.de.population.to_string()));
+            return Err(mismatch(
+                "--population",
+                c.population.to_string(),
+                config.de.population.to_string(),
+            ));
         }
         if c.strategy != config.de.strategy.to_string() {
-            return Err(mismatch("--strategy", c.strategy.clone(), config.de.strategy.to_string()));
+            return Err(mismatch(
+                "--strategy",
+                c.strategy.clone(),
+                config.de.strategy.to_string(),
+            ));
         }
         if c.seed != config.de.seed {
-            return Err(mismatch("--seed", c.seed.to_string(), config.de.seed.to_string()));
+            return Err(mismatch(
+                "--seed",
+                c.seed.to_string(),
+                config.de.seed.to_string(),
+            ));
         }
         if c.dim != space.dim() {
-            return Err(mismatch("a scene of", format!("{} free coordinates", c.dim), format!("{}", space.dim())));
+            return Err(mismatch(
+                "a scene of",
+                format!("{} free coordinates", c.dim),
+                format!("{}", space.dim()),
+            ));
         }
         Ok(c)
     }
@@ -79,7 +110,8 @@ impl Checkpoint {
     /// Writes the checkpoint atomically.
     pub fn save(&self, dir: &Path) -> Result<()> {
         let path = dir.join(FILE);
-        let text = serde_json::to_string(self).map_err(|e| Error::Run(format!("cannot encode checkpoint: {e}")))?;
+        let text = serde_json::to_string(self)
+            .map_err(|e| Error::Run(format!("cannot encode checkpoint: {e}")))?;
         write_atomic(&path, text.as_bytes())
     }
 }
@@ -88,7 +120,10 @@ impl Checkpoint {
 /// reader never sees half of it.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
     use std::io::Write;
-    let dir = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    let dir = path
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
     let mut tmp = tempfile::NamedTempFile::new_in(dir).map_err(|e| Error::io(path, e))?;
     tmp.write_all(bytes).map_err(|e| Error::io(path, e))?;
     tmp.persist(path).map_err(|e| Error::io(path, e.error))?;

@@ -55,7 +55,9 @@ impl Default for FitConfig {
             phase_generations: None,
             target_deviation: None,
             stagnation: None,
-            jobs: std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1),
+            jobs: std::thread::available_parallelism()
+                .map(|n| n.get())
+                .unwrap_or(1),
             resume: false,
             start_radius: None,
             snapshot_every: 10,
@@ -94,10 +96,19 @@ impl Observer for () {
 }
 
 /// Runs a fit of `scene` to `target` with `renderer`, writing into `dir`.
-pub fn run(scene: &Scene, target: &FitTarget, renderer: &dyn Renderer, config: &FitConfig, dir: &Path, observer: &mut dyn Observer) -> Result<FitResult> {
+pub fn run(
+    scene: &Scene,
+    target: &FitTarget,
+    renderer: &dyn Renderer,
+    config: &FitConfig,
+    dir: &Path,
+    observer: &mut dyn Observer,
+) -> Result<FitResult> {
     let space = ParamSpace::from_scene(scene);
     if space.is_empty() {
-        return Err(Error::Usage("the scene has no \"free\" parameters to fit".into()));
+        return Err(Error::Usage(
+            "the scene has no \"free\" parameters to fit".into(),
+        ));
     }
     if (scene.image.width, scene.image.height) != target.image.dimensions() {
         return Err(Error::Usage(format!(
@@ -108,7 +119,10 @@ pub fn run(scene: &Scene, target: &FitTarget, renderer: &dyn Renderer, config: &
             scene.image.height
         )));
     }
-    config.de.validate().map_err(|e| Error::Usage(e.to_string()))?;
+    config
+        .de
+        .validate()
+        .map_err(|e| Error::Usage(e.to_string()))?;
     std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
     let phases = space.phases();
     let budgets = phase_budgets(config, phases.len())?;
@@ -156,12 +170,22 @@ pub fn run(scene: &Scene, target: &FitTarget, renderer: &dyn Renderer, config: &
                 stop_reason = reason;
                 break;
             }
-            if config.interrupt.as_ref().is_some_and(|f| f.load(Ordering::SeqCst)) {
-                return Err(Error::Run(format!("interrupted; the checkpoint in {} resumes the run (--resume)", dir.display())));
+            if config
+                .interrupt
+                .as_ref()
+                .is_some_and(|f| f.load(Ordering::SeqCst))
+            {
+                return Err(Error::Run(format!(
+                    "interrupted; the checkpoint in {} resumes the run (--resume)",
+                    dir.display()
+                )));
             }
             let generation_started = Instant::now();
             let candidates = de.ask();
-            let scenes: Vec<Scene> = candidates.iter().map(|u| sub.scene_at(&state.base, u)).collect();
+            let scenes: Vec<Scene> = candidates
+                .iter()
+                .map(|u| sub.scene_at(&state.base, u))
+                .collect();
             let global_gen = state.generation_offset + de.generation();
             let images = session.render_batch(&scenes, render_seed(config.de.seed, global_gen));
             let mut failures = Vec::new();
@@ -169,9 +193,17 @@ pub fn run(scene: &Scene, target: &FitTarget, renderer: &dyn Renderer, config: &
                 .iter()
                 .enumerate()
                 .map(|(i, r)| match r {
-                    Ok(img) if img.dimensions() == target.image.dimensions() => deviation(&target.image, img, target.mask.as_ref()).fitness(),
+                    Ok(img) if img.dimensions() == target.image.dimensions() => {
+                        deviation(&target.image, img, target.mask.as_ref()).fitness()
+                    }
                     Ok(img) => {
-                        failures.push(format!("generation {global_gen} candidate {i}: image is {}x{}, expected {}x{}", img.width(), img.height(), target.image.width(), target.image.height()));
+                        failures.push(format!(
+                            "generation {global_gen} candidate {i}: image is {}x{}, expected {}x{}",
+                            img.width(),
+                            img.height(),
+                            target.image.width(),
+                            target.image.height()
+                        ));
                         f64::INFINITY
                     }
                     Err(f) => {
@@ -202,12 +234,20 @@ pub fn run(scene: &Scene, target: &FitTarget, renderer: &dyn Renderer, config: &
             let evaluations = state.evaluations_before + de.evaluations();
             let global_gen = state.generation_offset + de.generation();
             let best_scene = sub.scene_at(&state.base, de.best().0);
-            let best_dev = best_image.as_ref().map(|img| deviation(&target.image, img, target.mask.as_ref())).unwrap_or_default();
+            let best_dev = best_image
+                .as_ref()
+                .map(|img| deviation(&target.image, img, target.mask.as_ref()))
+                .unwrap_or_default();
             if global_gen % config.snapshot_every.max(1) == 0 {
                 if let Some(img) = &best_image {
                     output::snapshot(dir, global_gen, img)?;
                 }
-                log.progress(global_gen, evaluations, &best_dev, &space.json_values(&best_scene))?;
+                log.progress(
+                    global_gen,
+                    evaluations,
+                    &best_dev,
+                    &space.json_values(&best_scene),
+                )?;
             }
             state.elapsed_before += generation_started.elapsed().as_secs_f64();
             state.save(dir)?;
@@ -216,7 +256,8 @@ pub fn run(scene: &Scene, target: &FitTarget, renderer: &dyn Renderer, config: &
                 total_generations: budgets.iter().sum(),
                 evaluations,
                 best: best_dev,
-                renders_per_second: candidates.len() as f64 / generation_started.elapsed().as_secs_f64().max(1e-9),
+                renders_per_second: candidates.len() as f64
+                    / generation_started.elapsed().as_secs_f64().max(1e-9),
                 elapsed: state.elapsed_before,
                 phase,
                 failures: &failures,
@@ -260,7 +301,10 @@ pub fn run(scene: &Scene, target: &FitTarget, renderer: &dyn Renderer, config: &
 fn phase_budgets(config: &FitConfig, phases: usize) -> Result<Vec<usize>> {
     match &config.phase_generations {
         Some(v) if v.len() == phases => Ok(v.clone()),
-        Some(v) => Err(Error::Usage(format!("--phase-generations: the scene has {phases} phase(s), got {} numbers", v.len()))),
+        Some(v) => Err(Error::Usage(format!(
+            "--phase-generations: the scene has {phases} phase(s), got {} numbers",
+            v.len()
+        ))),
         None => {
             let each = config.generations / phases;
             let mut v = vec![each; phases];

@@ -33,7 +33,13 @@ impl FitResult {
     pub fn load(dir: &Path) -> Result<FitResult> {
         let path = dir.join("result.json");
         let text = std::fs::read_to_string(&path).map_err(|e| Error::io(&path, e))?;
-        serde_json::from_str(&text).map_err(|e| Error::invalid(path.display().to_string(), "(top level)", format!("not a scenefit result ({e})")))
+        serde_json::from_str(&text).map_err(|e| {
+            Error::invalid(
+                path.display().to_string(),
+                "(top level)",
+                format!("not a scenefit result ({e})"),
+            )
+        })
     }
 }
 
@@ -60,13 +66,28 @@ impl RunLog {
             writeln!(progress, "# generation evaluations deviation_average deviation_r deviation_g deviation_b params").map_err(|e| Error::io(&path, e))?;
             let _ = std::fs::remove_file(dir.join("failures.log"));
         }
-        Ok(RunLog { progress, failures_path: dir.join("failures.log"), failures: None, failure_count: 0 })
+        Ok(RunLog {
+            progress,
+            failures_path: dir.join("failures.log"),
+            failures: None,
+            failure_count: 0,
+        })
     }
 
-    pub fn progress(&mut self, generation: usize, evaluations: usize, d: &Deviation, params: &serde_json::Map<String, serde_json::Value>) -> Result<()> {
+    pub fn progress(
+        &mut self,
+        generation: usize,
+        evaluations: usize,
+        d: &Deviation,
+        params: &serde_json::Map<String, serde_json::Value>,
+    ) -> Result<()> {
         let params = serde_json::to_string(params).unwrap_or_default();
-        writeln!(self.progress, "{generation} {evaluations} {:.4} {:.4} {:.4} {:.4} {params}", d.average, d.r, d.g, d.b)
-            .map_err(|e| Error::io(&self.failures_path.with_file_name("progress.txt"), e))
+        writeln!(
+            self.progress,
+            "{generation} {evaluations} {:.4} {:.4} {:.4} {:.4} {params}",
+            d.average, d.r, d.g, d.b
+        )
+        .map_err(|e| Error::io(&self.failures_path.with_file_name("progress.txt"), e))
     }
 
     pub fn failures(&mut self, lines: &[String]) -> Result<()> {
@@ -75,7 +96,11 @@ impl RunLog {
         }
         self.failure_count += lines.len();
         if self.failures.is_none() {
-            let f = std::fs::OpenOptions::new().create(true).append(true).open(&self.failures_path).map_err(|e| Error::io(&self.failures_path, e))?;
+            let f = std::fs::OpenOptions::new()
+                .create(true)
+                .append(true)
+                .open(&self.failures_path)
+                .map_err(|e| Error::io(&self.failures_path, e))?;
             self.failures = Some(f);
         }
         let f = self.failures.as_mut().expect("opened above");
@@ -102,7 +127,14 @@ pub fn clear_snapshots(dir: &Path) -> Result<()> {
     for e in entries.flatten() {
         let name = e.file_name().to_string_lossy().to_string();
         let stale = (name.starts_with("best_g") && name.ends_with(".bmp"))
-            || matches!(name.as_str(), "result.json" | "fitted_scene.json" | "best.png" | "checkpoint.json" | "failures.log");
+            || matches!(
+                name.as_str(),
+                "result.json"
+                    | "fitted_scene.json"
+                    | "best.png"
+                    | "checkpoint.json"
+                    | "failures.log"
+            );
         if stale {
             let _ = std::fs::remove_file(e.path());
         }

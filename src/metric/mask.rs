@@ -13,7 +13,11 @@ pub struct Mask {
 
 impl Mask {
     pub fn from_pixels(width: u32, height: u32, pixels: Vec<u32>) -> Mask {
-        Mask { width, height, pixels }
+        Mask {
+            width,
+            height,
+            pixels,
+        }
     }
 
     /// Reads a mask image; it must be `width` x `height`, or is resized to it
@@ -24,14 +28,31 @@ impl Mask {
         if img.dimensions() != (width, height) {
             return Err(Error::Image {
                 path: path.to_path_buf(),
-                message: format!("--mask: expected {width}x{height} (the scene's image size), got {}x{}", img.width(), img.height()),
+                message: format!(
+                    "--mask: expected {width}x{height} (the scene's image size), got {}x{}",
+                    img.width(),
+                    img.height()
+                ),
             });
         }
-        let pixels: Vec<u32> = img.as_raw().iter().enumerate().filter(|(_, &v)| v > 127).map(|(i, _)| i as u32).collect();
+        let pixels: Vec<u32> = img
+            .as_raw()
+            .iter()
+            .enumerate()
+            .filter(|(_, &v)| v > 127)
+            .map(|(i, _)| i as u32)
+            .collect();
         if pixels.is_empty() {
-            return Err(Error::Image { path: path.to_path_buf(), message: "--mask: no pixel is set (expected white where pixels count)".into() });
+            return Err(Error::Image {
+                path: path.to_path_buf(),
+                message: "--mask: no pixel is set (expected white where pixels count)".into(),
+            });
         }
-        Ok(Mask { width, height, pixels })
+        Ok(Mask {
+            width,
+            height,
+            pixels,
+        })
     }
 
     pub fn pixels(&self) -> &[u32] {

@@ -25,8 +25,17 @@ pub struct Deviation {
 impl Deviation {
     fn from_sums(sums: [u64; 3], count: u64) -> Deviation {
         let scale = 100.0 / (255.0 * count.max(1) as f64);
-        let (r, g, b) = (sums[0] as f64 * scale, sums[1] as f64 * scale, sums[2] as f64 * scale);
-        Deviation { r, g, b, average: (r + g + b) / 3.0 }
+        let (r, g, b) = (
+            sums[0] as f64 * scale,
+            sums[1] as f64 * scale,
+            sums[2] as f64 * scale,
+        );
+        Deviation {
+            r,
+            g,
+            b,
+            average: (r + g + b) / 3.0,
+        }
     }
 
     /// What the optimizer minimises.

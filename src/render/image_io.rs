@@ -10,7 +10,9 @@ pub fn read_image(path: &Path, what: &str) -> Result<Image> {
     let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
     let img = image::load_from_memory(&bytes).map_err(|e| Error::Image {
         path: path.to_path_buf(),
-        message: format!("{what}: expected a PNG, BMP or other image file, could not decode it ({e})"),
+        message: format!(
+            "{what}: expected a PNG, BMP or other image file, could not decode it ({e})"
+        ),
     })?;
     Ok(img.to_rgb8())
 }
@@ -34,17 +36,31 @@ pub fn read_target(path: &Path, width: u32, height: u32) -> Result<Image> {
 /// Writes an image atomically (a temporary file renamed into place), as
 /// PNG or BMP by the extension.
 pub fn write_image(img: &Image, path: &Path) -> Result<()> {
-    let format = match path.extension().and_then(|e| e.to_str()).map(|e| e.to_ascii_lowercase()).as_deref() {
+    let format = match path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(|e| e.to_ascii_lowercase())
+        .as_deref()
+    {
         Some("bmp") => image::ImageFormat::Bmp,
         Some("png") => image::ImageFormat::Png,
         _ => {
-            return Err(Error::Image { path: path.to_path_buf(), message: "expected a file name ending in .png or .bmp".into() });
+            return Err(Error::Image {
+                path: path.to_path_buf(),
+                message: "expected a file name ending in .png or .bmp".into(),
+            });
         }
     };
-    let dir = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    let dir = path
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
     let tmp = tempfile::NamedTempFile::new_in(dir).map_err(|e| Error::io(path, e))?;
     img.write_to(&mut std::io::BufWriter::new(tmp.as_file()), format)
-        .map_err(|e| Error::Image { path: path.to_path_buf(), message: e.to_string() })?;
+        .map_err(|e| Error::Image {
+            path: path.to_path_buf(),
+            message: e.to_string(),
+        })?;
     tmp.persist(path).map_err(|e| Error::io(path, e.error))?;
     Ok(())
 }

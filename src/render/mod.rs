@@ -3,8 +3,8 @@
 //! `cmd:TEMPLATE`, `worker:COMMAND`). Nothing outside this module knows
 //! which backend runs.
 
-pub mod phong;
 pub mod image_io;
+pub mod phong;
 pub mod srgb;
 
 use crate::error::{Error, Result};
@@ -41,12 +41,19 @@ pub trait Renderer: Send + Sync {
     /// Renders at once when the user does not say (`--jobs`): the number of
     /// cores for CPU-bound renderers; more for those that mostly wait.
     fn default_jobs(&self) -> usize {
-        std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1)
+        std::thread::available_parallelism()
+            .map(|n| n.get())
+            .unwrap_or(1)
     }
 
     /// Prepares to render variants of `base` in which only the parameters
     /// of `varying` change, with up to `jobs` renders at once.
-    fn session(&self, base: &Scene, varying: &ParamSpace, jobs: usize) -> Result<Box<dyn RenderSession>>;
+    fn session(
+        &self,
+        base: &Scene,
+        varying: &ParamSpace,
+        jobs: usize,
+    ) -> Result<Box<dyn RenderSession>>;
 }
 
 /// A prepared renderer: renders batches of scene variants.
@@ -75,6 +82,11 @@ pub fn render_one(renderer: &dyn Renderer, scene: &Scene, seed: u64) -> Result<I
     session
         .render_batch(std::slice::from_ref(scene), seed)
         .pop()
-        .unwrap_or_else(|| Err(RenderFailure { message: "no image".into(), stderr: String::new() }))
+        .unwrap_or_else(|| {
+            Err(RenderFailure {
+                message: "no image".into(),
+                stderr: String::new(),
+            })
+        })
         .map_err(|f| Error::Run(format!("{}: render failed: {f}", renderer.name())))
 }

@@ -4,7 +4,11 @@
 /// sRGB-encodes a linear value (clamped to [0, 1]) to 8 bits, exactly.
 pub fn encode(x: f64) -> u8 {
     let x = x.clamp(0.0, 1.0);
-    let s = if x <= 0.0031308 { 12.92 * x } else { 1.055 * x.powf(1.0 / 2.4) - 0.055 };
+    let s = if x <= 0.0031308 {
+        12.92 * x
+    } else {
+        1.055 * x.powf(1.0 / 2.4) - 0.055
+    };
     (s * 255.0 + 0.5) as u8
 }
 
@@ -53,8 +57,13 @@ impl Encoder {
             }
             *t = hi as f32;
         }
-        let mut e = Encoder { thresholds, lut: Vec::new() };
-        e.lut = (0..LUT_SIZE).map(|i| e.search(i as f32 / LUT_SIZE as f32)).collect();
+        let mut e = Encoder {
+            thresholds,
+            lut: Vec::new(),
+        };
+        e.lut = (0..LUT_SIZE)
+            .map(|i| e.search(i as f32 / LUT_SIZE as f32))
+            .collect();
         e
     }
 

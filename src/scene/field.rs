@@ -285,7 +285,9 @@ impl Field {
     pub fn is_color(&self) -> bool {
         matches!(
             self,
-            Field::Ambient | Field::Light(_, LightField::Color) | Field::Material(_, MaterialField::Color)
+            Field::Ambient
+                | Field::Light(_, LightField::Color)
+                | Field::Material(_, MaterialField::Color)
         )
     }
 
@@ -301,9 +303,12 @@ impl Field {
 }
 
 fn object(scene: &Scene, name: &str) -> Result<usize, String> {
-    scene
-        .object_index(name)
-        .ok_or_else(|| format!("no object named \"{name}\" (objects: {})", names(scene.objects.iter().map(|o| &o.name))))
+    scene.object_index(name).ok_or_else(|| {
+        format!(
+            "no object named \"{name}\" (objects: {})",
+            names(scene.objects.iter().map(|o| &o.name))
+        )
+    })
 }
 
 fn names<'a>(it: impl Iterator<Item = &'a String>) -> String {

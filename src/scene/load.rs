@@ -16,11 +16,15 @@ pub struct Override {
 impl std::str::FromStr for Override {
     type Err = String;
     fn from_str(s: &str) -> std::result::Result<Self, String> {
-        let (path, json) = s
-            .split_once('=')
-            .ok_or_else(|| format!("--set {s}: expected PARAM=JSON, e.g. lights.key.position=[1,2,3]"))?;
-        let value = serde_json::from_str(json).map_err(|e| format!("--set {s}: the value is not JSON ({e})"))?;
-        Ok(Override { path: path.trim().to_string(), value })
+        let (path, json) = s.split_once('=').ok_or_else(|| {
+            format!("--set {s}: expected PARAM=JSON, e.g. lights.key.position=[1,2,3]")
+        })?;
+        let value = serde_json::from_str(json)
+            .map_err(|e| format!("--set {s}: the value is not JSON ({e})"))?;
+        Ok(Override {
+            path: path.trim().to_string(),
+            value,
+        })
     }
 }
 
@@ -37,10 +41,16 @@ pub fn load_with(path: &Path, overrides: &[Override]) -> Result<Scene> {
 
 /// Parses scene text; `file` names it in messages.
 pub fn parse(text: &str, file: &str, overrides: &[Override]) -> Result<Scene> {
-    let mut value: serde_json::Value = serde_json::from_str(text)
-        .map_err(|e| Error::invalid(file, format!("line {} column {}", e.line(), e.column()), format!("not valid JSON: {e}")))?;
+    let mut value: serde_json::Value = serde_json::from_str(text).map_err(|e| {
+        Error::invalid(
+            file,
+            format!("line {} column {}", e.line(), e.column()),
+            format!("not valid JSON: {e}"),
+        )
+    })?;
     for o in overrides {
-        apply_override(&mut value, o).map_err(|m| Error::invalid(file, &o.path, format!("--set: {m}")))?;
+        apply_override(&mut value, o)
+            .map_err(|m| Error::invalid(file, &o.path, format!("--set: {m}")))?;
     }
     from_value(value, file)
 }
@@ -49,7 +59,11 @@ pub fn parse(text: &str, file: &str, overrides: &[Override]) -> Result<Scene> {
 pub fn from_value(value: serde_json::Value, file: &str) -> Result<Scene> {
     let scene: Scene = serde_path_to_error::deserialize(value).map_err(|e| {
         let key = e.path().to_string();
-        let key = if key == "." { "(top level)".to_string() } else { key };
+        let key = if key == "." {
+            "(top level)".to_string()
+        } else {
+            key
+        };
         Error::invalid(file, key, e.into_inner().to_string())
     })?;
     validate(&scene, file)?;
@@ -66,7 +80,9 @@ fn apply_override(root: &mut serde_json::Value, o: &Override) -> std::result::Re
         let key = parts[i];
         let last = i + 1 == parts.len();
         let named_list = (key == "lights" || key == "objects") && i == 0;
-        let obj = node.as_object_mut().ok_or_else(|| format!("\"{}\" is not an object", parts[..i].join(".")))?;
+        let obj = node
+            .as_object_mut()
+            .ok_or_else(|| format!("\"{}\" is not an object", parts[..i].join(".")))?;
         if last {
             obj.insert(key.to_string(), o.value.clone());
             return Ok(());

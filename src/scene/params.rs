@@ -26,7 +26,9 @@ impl ParamSpec {
 
     /// The scene value at unit-cube coordinates `u` (one per component).
     pub fn value_at(&self, u: &[f64]) -> Value {
-        let x: Vec<f64> = (0..self.dim()).map(|c| self.min[c] + u[c].clamp(0.0, 1.0) * (self.max[c] - self.min[c])).collect();
+        let x: Vec<f64> = (0..self.dim())
+            .map(|c| self.min[c] + u[c].clamp(0.0, 1.0) * (self.max[c] - self.min[c]))
+            .collect();
         if x.len() == 1 {
             Value::Scalar(x[0])
         } else {
@@ -105,7 +107,12 @@ impl ParamSpace {
     /// The sub-space of one phase.
     pub fn phase(&self, phase: u32) -> ParamSpace {
         ParamSpace {
-            specs: self.specs.iter().filter(|s| s.phase == phase).cloned().collect(),
+            specs: self
+                .specs
+                .iter()
+                .filter(|s| s.phase == phase)
+                .cloned()
+                .collect(),
         }
     }
 
@@ -187,8 +194,18 @@ mod tests {
         let a = space.json_values(&scene);
         let b = space.json_values(&back);
         for (k, v) in &a {
-            let x: Vec<f64> = serde_json::from_value(if v.is_array() { v.clone() } else { serde_json::json!([v]) }).unwrap();
-            let y: Vec<f64> = serde_json::from_value(if b[k].is_array() { b[k].clone() } else { serde_json::json!([b[k]]) }).unwrap();
+            let x: Vec<f64> = serde_json::from_value(if v.is_array() {
+                v.clone()
+            } else {
+                serde_json::json!([v])
+            })
+            .unwrap();
+            let y: Vec<f64> = serde_json::from_value(if b[k].is_array() {
+                b[k].clone()
+            } else {
+                serde_json::json!([b[k]])
+            })
+            .unwrap();
             for (p, q) in x.iter().zip(&y) {
                 assert!((p - q).abs() < 1e-12, "{k}: {x:?} vs {y:?}");
             }

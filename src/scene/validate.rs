@@ -12,10 +12,20 @@ use crate::math::V3;
 pub fn validate(scene: &Scene, file: &str) -> Result<()> {
     let err = |key: String, msg: String| Err(Error::invalid(file, key, msg));
     if scene.format != FORMAT {
-        return err("format".into(), format!("expected \"{FORMAT}\", got \"{}\"", scene.format));
+        return err(
+            "format".into(),
+            format!("expected \"{FORMAT}\", got \"{}\"", scene.format),
+        );
     }
-    if scene.image.width == 0 || scene.image.height == 0 || scene.image.width > 16384 || scene.image.height > 16384 {
-        return err("image".into(), "expected width and height between 1 and 16384".into());
+    if scene.image.width == 0
+        || scene.image.height == 0
+        || scene.image.width > 16384
+        || scene.image.height > 16384
+    {
+        return err(
+            "image".into(),
+            "expected width and height between 1 and 16384".into(),
+        );
     }
     if scene.render.samples == 0 {
         return err("render.samples".into(), "expected at least 1".into());
@@ -29,7 +39,10 @@ pub fn validate(scene: &Scene, file: &str) -> Result<()> {
     for (i, l) in scene.lights.iter().enumerate() {
         let at = format!("lights[{i}]");
         if !seen.insert(&l.name) {
-            return err(format!("{at}.name"), format!("duplicate light name \"{}\"", l.name));
+            return err(
+                format!("{at}.name"),
+                format!("duplicate light name \"{}\"", l.name),
+            );
         }
         light(l, file, &at)?;
     }
@@ -37,7 +50,10 @@ pub fn validate(scene: &Scene, file: &str) -> Result<()> {
     for (i, o) in scene.objects.iter().enumerate() {
         let at = format!("objects[{i}]");
         if !seen.insert(&o.name) {
-            return err(format!("{at}.name"), format!("duplicate object name \"{}\"", o.name));
+            return err(
+                format!("{at}.name"),
+                format!("duplicate object name \"{}\"", o.name),
+            );
         }
         shape(&o.shape, file, &format!("{at}.shape"))?;
         material(&o.material, file, &format!("{at}.material"))?;
@@ -46,7 +62,10 @@ pub fn validate(scene: &Scene, file: &str) -> Result<()> {
     for (i, f) in scene.free.iter().enumerate() {
         let at = format!("free[{i}]");
         if !seen.insert(&f.param) {
-            return err(format!("{at}.param"), format!("\"{}\" is free twice", f.param));
+            return err(
+                format!("{at}.param"),
+                format!("\"{}\" is free twice", f.param),
+            );
         }
         free(scene, f, file, &at)?;
     }
@@ -59,28 +78,44 @@ fn finite3(v: Vec3) -> bool {
 
 fn non_negative3(file: &str, key: &str, v: Vec3) -> Result<()> {
     if !finite3(v) || v.iter().any(|&x| x < 0.0) {
-        return Err(Error::invalid(file, key, format!("expected three non-negative numbers, got {v:?}")));
+        return Err(Error::invalid(
+            file,
+            key,
+            format!("expected three non-negative numbers, got {v:?}"),
+        ));
     }
     Ok(())
 }
 
 fn non_negative(file: &str, key: &str, x: f64) -> Result<()> {
     if !x.is_finite() || x < 0.0 {
-        return Err(Error::invalid(file, key, format!("expected a non-negative number, got {x}")));
+        return Err(Error::invalid(
+            file,
+            key,
+            format!("expected a non-negative number, got {x}"),
+        ));
     }
     Ok(())
 }
 
 fn positive(file: &str, key: &str, x: f64) -> Result<()> {
     if !x.is_finite() || x <= 0.0 {
-        return Err(Error::invalid(file, key, format!("expected a positive number, got {x}")));
+        return Err(Error::invalid(
+            file,
+            key,
+            format!("expected a positive number, got {x}"),
+        ));
     }
     Ok(())
 }
 
 fn nonzero3(file: &str, key: &str, v: Vec3) -> Result<()> {
     if !finite3(v) || V3::from(v).length() < 1e-12 {
-        return Err(Error::invalid(file, key, format!("expected a non-zero vector, got {v:?}")));
+        return Err(Error::invalid(
+            file,
+            key,
+            format!("expected a non-zero vector, got {v:?}"),
+        ));
     }
     Ok(())
 }
@@ -98,11 +133,19 @@ fn forbidden<T>(file: &str, key: &str, v: &Option<T>, what: &str) -> Result<()> 
 
 fn camera(c: &Camera, file: &str) -> Result<()> {
     if !finite3(c.position) || !finite3(c.look_at) {
-        return Err(Error::invalid(file, "camera.position", "expected finite numbers"));
+        return Err(Error::invalid(
+            file,
+            "camera.position",
+            "expected finite numbers",
+        ));
     }
     let view = V3::from(c.look_at) - V3::from(c.position);
     if view.length() < 1e-9 {
-        return Err(Error::invalid(file, "camera.look_at", "must differ from camera.position"));
+        return Err(Error::invalid(
+            file,
+            "camera.look_at",
+            "must differ from camera.position",
+        ));
     }
     nonzero3(file, "camera.up", c.up)?;
     let up = V3::from(c.up).normalized();
@@ -115,16 +158,40 @@ fn camera(c: &Camera, file: &str) -> Result<()> {
     }
     match c.kind {
         CameraKind::Perspective => {
-            let fov = required(file, "camera.fov_y_deg", c.fov_y_deg, "a perspective camera needs fov_y_deg")?;
+            let fov = required(
+                file,
+                "camera.fov_y_deg",
+                c.fov_y_deg,
+                "a perspective camera needs fov_y_deg",
+            )?;
             if !(fov > 0.0 && fov < 180.0) {
-                return Err(Error::invalid(file, "camera.fov_y_deg", format!("expected a number in (0, 180), got {fov}")));
+                return Err(Error::invalid(
+                    file,
+                    "camera.fov_y_deg",
+                    format!("expected a number in (0, 180), got {fov}"),
+                ));
             }
-            forbidden(file, "camera.height", &c.height, "a perspective camera (use fov_y_deg)")
+            forbidden(
+                file,
+                "camera.height",
+                &c.height,
+                "a perspective camera (use fov_y_deg)",
+            )
         }
         CameraKind::Orthographic => {
-            let h = required(file, "camera.height", c.height, "an orthographic camera needs height (metres)")?;
+            let h = required(
+                file,
+                "camera.height",
+                c.height,
+                "an orthographic camera needs height (metres)",
+            )?;
             positive(file, "camera.height", h)?;
-            forbidden(file, "camera.fov_y_deg", &c.fov_y_deg, "an orthographic camera (use height)")
+            forbidden(
+                file,
+                "camera.fov_y_deg",
+                &c.fov_y_deg,
+                "an orthographic camera (use height)",
+            )
         }
     }
 }
@@ -135,16 +202,40 @@ fn light(l: &Light, file: &str, at: &str) -> Result<()> {
     non_negative(file, &format!("{at}.radius"), l.radius)?;
     match l.kind {
         LightKind::Point => {
-            let p = required(file, &format!("{at}.position"), l.position, "a point light needs a position")?;
+            let p = required(
+                file,
+                &format!("{at}.position"),
+                l.position,
+                "a point light needs a position",
+            )?;
             if !finite3(p) {
-                return Err(Error::invalid(file, format!("{at}.position"), "expected finite numbers"));
+                return Err(Error::invalid(
+                    file,
+                    format!("{at}.position"),
+                    "expected finite numbers",
+                ));
             }
-            forbidden(file, &format!("{at}.direction"), &l.direction, "a point light (use position)")
+            forbidden(
+                file,
+                &format!("{at}.direction"),
+                &l.direction,
+                "a point light (use position)",
+            )
         }
         LightKind::Directional => {
-            let d = required(file, &format!("{at}.direction"), l.direction, "a directional light needs a direction (towards the light)")?;
+            let d = required(
+                file,
+                &format!("{at}.direction"),
+                l.direction,
+                "a directional light needs a direction (towards the light)",
+            )?;
             nonzero3(file, &format!("{at}.direction"), d)?;
-            forbidden(file, &format!("{at}.position"), &l.position, "a directional light (use direction)")
+            forbidden(
+                file,
+                &format!("{at}.position"),
+                &l.position,
+                "a directional light (use direction)",
+            )
         }
     }
 }
@@ -171,10 +262,18 @@ fn shape(s: &Shape, file: &str, at: &str) -> Result<()> {
     for (name, present) in all {
         let needed = wanted.contains(&name);
         if needed && !present {
-            return Err(Error::invalid(file, key(name), format!("missing; {kind} needs {}", wanted.join(", "))));
+            return Err(Error::invalid(
+                file,
+                key(name),
+                format!("missing; {kind} needs {}", wanted.join(", ")),
+            ));
         }
         if !needed && present {
-            return Err(Error::invalid(file, key(name), format!("not used by {kind} (it takes {})", wanted.join(", "))));
+            return Err(Error::invalid(
+                file,
+                key(name),
+                format!("not used by {kind} (it takes {})", wanted.join(", ")),
+            ));
         }
     }
     let finite = |k: &str, v: Option<Vec3>| -> Result<()> {
@@ -183,7 +282,13 @@ fn shape(s: &Shape, file: &str, at: &str) -> Result<()> {
             _ => Ok(()),
         }
     };
-    for (k, v) in [("center", s.center), ("point", s.point), ("corner", s.corner), ("min", s.min), ("max", s.max)] {
+    for (k, v) in [
+        ("center", s.center),
+        ("point", s.point),
+        ("corner", s.corner),
+        ("min", s.min),
+        ("max", s.max),
+    ] {
         finite(k, v)?;
     }
     match s.kind {
@@ -194,14 +299,22 @@ fn shape(s: &Shape, file: &str, at: &str) -> Result<()> {
             nonzero3(file, &key("edge_u"), u)?;
             nonzero3(file, &key("edge_v"), v)?;
             if V3::from(u).cross(V3::from(v)).length() < 1e-12 {
-                return Err(Error::invalid(file, key("edge_v"), "is parallel to edge_u; expected two edges that span a parallelogram"));
+                return Err(Error::invalid(
+                    file,
+                    key("edge_v"),
+                    "is parallel to edge_u; expected two edges that span a parallelogram",
+                ));
             }
             Ok(())
         }
         ShapeKind::Box => {
             let (lo, hi) = (s.min.unwrap_or_default(), s.max.unwrap_or_default());
             if (0..3).any(|a| lo[a] >= hi[a]) {
-                return Err(Error::invalid(file, key("max"), format!("expected every component above min {lo:?}, got {hi:?}")));
+                return Err(Error::invalid(
+                    file,
+                    key("max"),
+                    format!("expected every component above min {lo:?}, got {hi:?}"),
+                ));
             }
             Ok(())
         }
@@ -220,15 +333,30 @@ fn material(m: &Material, file: &str, at: &str) -> Result<()> {
 }
 
 fn free(scene: &Scene, f: &FreeParam, file: &str, at: &str) -> Result<()> {
-    let field = Field::resolve(scene, &f.param).map_err(|m| Error::invalid(file, format!("{at}.param"), format!("\"{}\": {m}", f.param)))?;
-    let current = field.get(scene).ok_or_else(|| Error::invalid(file, format!("{at}.param"), format!("\"{}\" is not set in this scene", f.param)))?;
+    let field = Field::resolve(scene, &f.param).map_err(|m| {
+        Error::invalid(file, format!("{at}.param"), format!("\"{}\": {m}", f.param))
+    })?;
+    let current = field.get(scene).ok_or_else(|| {
+        Error::invalid(
+            file,
+            format!("{at}.param"),
+            format!("\"{}\" is not set in this scene", f.param),
+        )
+    })?;
     let n = current.components().len();
     let expand = |b: Bound, which: &str| -> Result<Vec<f64>> {
         match (b, n) {
             (Bound::Scalar(x), 1) => Ok(vec![x]),
             (Bound::Scalar(x), 3) => Ok(vec![x; 3]),
             (Bound::Vector(v), 3) => Ok(v.to_vec()),
-            (Bound::Vector(_), _) => Err(Error::invalid(file, format!("{at}.{which}"), format!("\"{}\" is a number; expected a number, not a vector", f.param))),
+            (Bound::Vector(_), _) => Err(Error::invalid(
+                file,
+                format!("{at}.{which}"),
+                format!(
+                    "\"{}\" is a number; expected a number, not a vector",
+                    f.param
+                ),
+            )),
             _ => unreachable!("fields are scalars or 3-vectors"),
         }
     };
@@ -236,34 +364,73 @@ fn free(scene: &Scene, f: &FreeParam, file: &str, at: &str) -> Result<()> {
     let hi = expand(f.max, "max")?;
     for c in 0..n {
         if !lo[c].is_finite() || !hi[c].is_finite() {
-            return Err(Error::invalid(file, format!("{at}.min"), "expected finite bounds"));
+            return Err(Error::invalid(
+                file,
+                format!("{at}.min"),
+                "expected finite bounds",
+            ));
         }
         if lo[c] > hi[c] {
-            return Err(Error::invalid(file, format!("{at}.max"), format!("expected max >= min, got min {:?} and max {:?}", lo, hi)));
+            return Err(Error::invalid(
+                file,
+                format!("{at}.max"),
+                format!("expected max >= min, got min {:?} and max {:?}", lo, hi),
+            ));
         }
     }
     if f.space == ColorSpace::Hsv {
         if !field.is_color() {
-            return Err(Error::invalid(file, format!("{at}.space"), format!("\"hsv\" is for colours; \"{}\" is not one", f.param)));
+            return Err(Error::invalid(
+                file,
+                format!("{at}.space"),
+                format!("\"hsv\" is for colours; \"{}\" is not one", f.param),
+            ));
         }
-        if lo.iter().chain(hi.iter()).any(|&x| !(0.0..=1.0).contains(&x)) {
-            return Err(Error::invalid(file, format!("{at}.min"), "HSV bounds must lie in [0, 1]"));
+        if lo
+            .iter()
+            .chain(hi.iter())
+            .any(|&x| !(0.0..=1.0).contains(&x))
+        {
+            return Err(Error::invalid(
+                file,
+                format!("{at}.min"),
+                "HSV bounds must lie in [0, 1]",
+            ));
         }
     }
     if field.is_color() && f.space == ColorSpace::Rgb && lo.iter().any(|&x| x < 0.0) {
-        return Err(Error::invalid(file, format!("{at}.min"), "colours cannot go below 0"));
+        return Err(Error::invalid(
+            file,
+            format!("{at}.min"),
+            "colours cannot go below 0",
+        ));
     }
     if f.phase == Some(0) {
-        return Err(Error::invalid(file, format!("{at}.phase"), "expected 1 or more"));
+        return Err(Error::invalid(
+            file,
+            format!("{at}.phase"),
+            "expected 1 or more",
+        ));
     }
     if let Value::Scalar(_) = current {
         let physical_min = match field {
-            Field::Material(_, super::field::MaterialField::Shininess | super::field::MaterialField::Ior) => f64::MIN_POSITIVE,
+            Field::Material(
+                _,
+                super::field::MaterialField::Shininess | super::field::MaterialField::Ior,
+            ) => f64::MIN_POSITIVE,
             Field::Camera(_) | Field::Shape(..) => f64::MIN_POSITIVE,
             _ => 0.0,
         };
         if lo[0] < physical_min {
-            return Err(Error::invalid(file, format!("{at}.min"), format!("\"{}\" cannot go below {}", f.param, if physical_min > 0.0 { "or to 0" } else { "0" })));
+            return Err(Error::invalid(
+                file,
+                format!("{at}.min"),
+                format!(
+                    "\"{}\" cannot go below {}",
+                    f.param,
+                    if physical_min > 0.0 { "or to 0" } else { "0" }
+                ),
+            ));
         }
     }
     Ok(())

@@ -50,8 +50,13 @@ impl CameraRays {
         let sx = (2.0 * x / self.width - 1.0) * self.half_w;
         let sy = (1.0 - 2.0 * y / self.height) * self.half_h;
         match self.kind {
-            CameraKind::Perspective => (self.origin, (self.forward + self.right * sx + self.up * sy).normalized()),
-            CameraKind::Orthographic => (self.origin + self.right * sx + self.up * sy, self.forward),
+            CameraKind::Perspective => (
+                self.origin,
+                (self.forward + self.right * sx + self.up * sy).normalized(),
+            ),
+            CameraKind::Orthographic => {
+                (self.origin + self.right * sx + self.up * sy, self.forward)
+            }
         }
     }
 }

@@ -10,11 +10,23 @@ pub const EPS: f64 = 1e-7;
 
 #[derive(Clone, Debug)]
 pub enum Prim {
-    Sphere { c: V3, r2: f64 },
-    Plane { p: V3, n: V3 },
+    Sphere {
+        c: V3,
+        r2: f64,
+    },
+    Plane {
+        p: V3,
+        n: V3,
+    },
     /// Corner `o`, edges `u`, `v`, unit normal `n`; `w` = (u x v)/|u x v|^2
     /// turns a point into its (alpha, beta) coordinates on the quad.
-    Quad { o: V3, u: V3, v: V3, n: V3, w: V3 },
+    Quad {
+        o: V3,
+        u: V3,
+        v: V3,
+        n: V3,
+        w: V3,
+    },
 }
 
 /// A ray hit: distance along the ray, geometric normal (unit, not yet turned
@@ -30,7 +42,12 @@ pub struct Hit {
 #[derive(Clone, Copy, Debug)]
 pub enum Occluder {
     /// A sphere, as the cone of directions it covers from the point.
-    Cone { axis: V3, cos_max: f64, center_dist: f64, prim: u32 },
+    Cone {
+        axis: V3,
+        cos_max: f64,
+        center_dist: f64,
+        prim: u32,
+    },
     Prim(u32),
 }
 
@@ -53,7 +70,10 @@ impl Geometry {
             match s.kind {
                 ShapeKind::Sphere => {
                     let r = s.radius.unwrap_or(1.0);
-                    add(Prim::Sphere { c: V3::from(s.center.unwrap_or_default()), r2: r * r });
+                    add(Prim::Sphere {
+                        c: V3::from(s.center.unwrap_or_default()),
+                        r2: r * r,
+                    });
                 }
                 ShapeKind::Plane => add(Prim::Plane {
                     p: V3::from(s.point.unwrap_or_default()),
@@ -68,7 +88,11 @@ impl Geometry {
                     let lo = V3::from(s.min.unwrap_or_default());
                     let hi = V3::from(s.max.unwrap_or([1.0; 3]));
                     let d = hi - lo;
-                    let (ex, ey, ez) = (V3::new(d.x, 0.0, 0.0), V3::new(0.0, d.y, 0.0), V3::new(0.0, 0.0, d.z));
+                    let (ex, ey, ez) = (
+                        V3::new(d.x, 0.0, 0.0),
+                        V3::new(0.0, d.y, 0.0),
+                        V3::new(0.0, 0.0, d.z),
+                    );
                     add(quad(lo, ex, ey));
                     add(quad(lo + ez, ex, ey));
                     add(quad(lo, ey, ez));
@@ -88,7 +112,11 @@ impl Geometry {
         for (i, prim) in self.prims.iter().enumerate() {
             if let Some((t, n)) = prim.intersect(o, d, t_best) {
                 t_best = t;
-                best = Some(Hit { t, n, object: self.owner[i] });
+                best = Some(Hit {
+                    t,
+                    n,
+                    object: self.owner[i],
+                });
             }
         }
         best
@@ -101,7 +129,12 @@ impl Geometry {
             let d2 = to.dot(to);
             if d2 > r2 * (1.0 + 1e-9) {
                 let dist = d2.sqrt();
-                return Occluder::Cone { axis: to / dist, cos_max: (1.0 - r2 / d2).sqrt(), center_dist: dist, prim };
+                return Occluder::Cone {
+                    axis: to / dist,
+                    cos_max: (1.0 - r2 / d2).sqrt(),
+                    center_dist: dist,
+                    prim,
+                };
             }
         }
         Occluder::Prim(prim)
@@ -112,11 +145,17 @@ impl Geometry {
     #[inline]
     pub fn occluded(&self, o: V3, d: V3, t_max: f64, occluders: &[Occluder]) -> bool {
         occluders.iter().any(|occ| match *occ {
-            Occluder::Cone { axis, cos_max, center_dist, prim } => {
+            Occluder::Cone {
+                axis,
+                cos_max,
+                center_dist,
+                prim,
+            } => {
                 // Inside the cone the sphere sees, the ray hits it; the hit
                 // lies before the centre's distance, so a farther light is
                 // certainly blocked, a nearer one needs the exact test.
-                d.dot(axis) > cos_max && (t_max >= center_dist || self.prims[prim as usize].hits_before(o, d, t_max))
+                d.dot(axis) > cos_max
+                    && (t_max >= center_dist || self.prims[prim as usize].hits_before(o, d, t_max))
             }
             Occluder::Prim(i) => self.prims[i as usize].hits_before(o, d, t_max),
         })
@@ -125,7 +164,13 @@ impl Geometry {
 
 fn quad(o: V3, u: V3, v: V3) -> Prim {
     let c = u.cross(v);
-    Prim::Quad { o, u, v, n: c.normalized(), w: c / c.dot(c) }
+    Prim::Quad {
+        o,
+        u,
+        v,
+        n: c.normalized(),
+        w: c / c.dot(c),
+    }
 }
 
 impl Prim {
@@ -216,7 +261,9 @@ impl Prim {
                 if side_p.abs() < 1e-9 {
                     return false; // p lies on the plane: the segment leaves it at once
                 }
-                corners(lo, hi).iter().any(|&k| (k - q).dot(n) * side_p <= 0.0)
+                corners(lo, hi)
+                    .iter()
+                    .any(|&k| (k - q).dot(n) * side_p <= 0.0)
             }
         }
     }

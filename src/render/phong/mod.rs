@@ -14,6 +14,7 @@
 
 mod camera;
 mod geometry;
+mod packed;
 mod paths;
 mod shade;
 
@@ -21,6 +22,7 @@ use super::srgb::Encoder;
 use super::{Image, RenderResult, RenderSession, Renderer};
 use crate::error::{Error, Result};
 use crate::scene::{ParamSpace, Scene};
+use packed::Packed;
 use paths::{Paths, Variation};
 use rayon::prelude::*;
 use std::sync::Arc;
@@ -33,22 +35,50 @@ impl Renderer for Phong {
         "phong".into()
     }
 
-    fn session(&self, base: &Scene, varying: &ParamSpace, jobs: usize) -> Result<Box<dyn RenderSession>> {
+    fn session(
+        &self,
+        base: &Scene,
+        varying: &ParamSpace,
+        jobs: usize,
+    ) -> Result<Box<dyn RenderSession>> {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(jobs.max(1))
             .build()
             .map_err(|e| Error::Run(format!("phong: cannot start threads: {e}")))?;
         let variation = Variation::new(base, varying);
         let moves_geometry = varying.fields().iter().any(|f| f.moves_geometry());
-        let cached = if moves_geometry { None } else { Some(Arc::new(pool.install(|| Paths::build(base, &variation)))) };
-        Ok(Box::new(PhongSession { pool, variation, cached, encoder: Encoder::new() }))
+        let cached = if moves_geometry {
+            None
+        } else {
+            Some(Arc::new(pool.install(|| Prepared::new(base, &variation))))
+        };
+        Ok(Box::new(PhongSession {
+            pool,
+            variation,
+            cached,
+            encoder: Encoder::new(),
+        }))
+    }
+}
+
+/// Hits traced once, in both layouts.
+struct Prepared {
+    paths: Paths,
+    packed: Packed,
+}
+
+impl Prepared {
+    fn new(scene: &Scene, variation: &Variation) -> Prepared {
+        let paths = Paths::build(scene, variation);
+        let packed = Packed::new(&paths, scene.lights.len());
+        Prepared { paths, packed }
     }
 }
 
 struct PhongSession {
     pool: rayon::ThreadPool,
     variation: Variation,
-    cached: Option<Arc<Paths>>,
+    cached: Option<Arc<Prepared>>,
     encoder: Encoder,
 }
 
@@ -57,8 +87,11 @@ impl PhongSession {
         let (w, h) = (scene.image.width, scene.image.height);
         let mut buf = vec![0u8; (w * h * 3) as usize];
         match &self.cached {
-            Some(paths) => shade::shade(paths, scene, &self.encoder, &mut buf),
-            None => shade::shade(&Paths::build(scene, &self.variation), scene, &self.encoder, &mut buf),
+            Some(p) => shade::shade(&p.paths, &p.packed, scene, &self.encoder, &mut buf),
+            None => {
+                let p = Prepared::new(scene, &self.variation);
+                shade::shade(&p.paths, &p.packed, scene, &self.encoder, &mut buf)
+            }
         }
         Ok(Image::from_raw(w, h, buf).expect("buffer sized to the image"))
     }
@@ -71,6 +104,7 @@ impl RenderSession for PhongSession {
 
     fn render_batch(&mut self, scenes: &[Scene], _seed: u64) -> Vec<RenderResult> {
         let this = &*self;
-        self.pool.install(|| scenes.par_iter().map(|s| this.render(s)).collect())
+        self.pool
+            .install(|| scenes.par_iter().map(|s| this.render(s)).collect())
     }
 }

@@ -79,20 +79,37 @@ pub struct Variation {
 impl Variation {
     pub fn new(scene: &Scene, space: &ParamSpace) -> Variation {
         let mut lights = vec![LightRange::Fixed; scene.lights.len()];
-        let mut reflective: Vec<bool> = scene.objects.iter().map(|o| o.material.reflection > 0.0).collect();
-        let mut transmissive: Vec<bool> = scene.objects.iter().map(|o| o.material.transmission > 0.0).collect();
+        let mut reflective: Vec<bool> = scene
+            .objects
+            .iter()
+            .map(|o| o.material.reflection > 0.0)
+            .collect();
+        let mut transmissive: Vec<bool> = scene
+            .objects
+            .iter()
+            .map(|o| o.material.transmission > 0.0)
+            .collect();
         for s in &space.specs {
             match s.field {
                 Field::Light(i, LightField::Position) => {
-                    lights[i] = LightRange::Moving(V3::new(s.min[0], s.min[1], s.min[2]), V3::new(s.max[0], s.max[1], s.max[2]))
+                    lights[i] = LightRange::Moving(
+                        V3::new(s.min[0], s.min[1], s.min[2]),
+                        V3::new(s.max[0], s.max[1], s.max[2]),
+                    )
                 }
                 Field::Light(i, LightField::Direction) => lights[i] = LightRange::Turning,
                 Field::Material(i, MaterialField::Reflection) => reflective[i] |= s.max[0] > 0.0,
-                Field::Material(i, MaterialField::Transmission) => transmissive[i] |= s.max[0] > 0.0,
+                Field::Material(i, MaterialField::Transmission) => {
+                    transmissive[i] |= s.max[0] > 0.0
+                }
                 _ => {}
             }
         }
-        Variation { lights, reflective, transmissive }
+        Variation {
+            lights,
+            reflective,
+            transmissive,
+        }
     }
 }
 
@@ -106,7 +123,14 @@ impl Paths {
         let rows: Vec<(Vec<Vertex>, Vec<Shadow>, Vec<Occluder>)> = (0..h)
             .into_par_iter()
             .map(|y| {
-                let mut t = Tracer { scene, geometry: &geometry, var, verts: Vec::new(), shadow: Vec::new(), occluders: Vec::new() };
+                let mut t = Tracer {
+                    scene,
+                    geometry: &geometry,
+                    var,
+                    verts: Vec::new(),
+                    shadow: Vec::new(),
+                    occluders: Vec::new(),
+                };
                 for x in 0..w {
                     for sy in 0..aa {
                         for sx in 0..aa {
@@ -120,7 +144,15 @@ impl Paths {
                 (t.verts, t.shadow, t.occluders)
             })
             .collect();
-        let mut paths = Paths { width: w, height: h, samples_per_pixel: aa * aa, verts: Vec::new(), shadow: Vec::new(), occluders: Vec::new(), geometry };
+        let mut paths = Paths {
+            width: w,
+            height: h,
+            samples_per_pixel: aa * aa,
+            verts: Vec::new(),
+            shadow: Vec::new(),
+            occluders: Vec::new(),
+            geometry,
+        };
         for (verts, shadow, occluders) in rows {
             let base_v = paths.verts.len() as u32;
             let base_o = paths.occluders.len() as u32;
@@ -131,7 +163,10 @@ impl Paths {
                 v
             }));
             paths.shadow.extend(shadow.into_iter().map(|s| match s {
-                Shadow::Test { start, len } => Shadow::Test { start: start + base_o, len },
+                Shadow::Test { start, len } => Shadow::Test {
+                    start: start + base_o,
+                    len,
+                },
                 other => other,
             }));
             paths.occluders.extend(occluders);
@@ -158,7 +193,15 @@ impl Tracer<'_> {
         let entering = hit.n.dot(d) < 0.0;
         let n = if entering { hit.n } else { -hit.n };
         let index = self.verts.len() as u32;
-        self.verts.push(Vertex { pixel, object: hit.object, parent, via, p, n, v: -d });
+        self.verts.push(Vertex {
+            pixel,
+            object: hit.object,
+            parent,
+            via,
+            p,
+            n,
+            v: -d,
+        });
         for l in 0..self.scene.lights.len() {
             let s = self.classify(p, n, hit.object, l);
             self.shadow.push(s);
@@ -170,7 +213,14 @@ impl Tracer<'_> {
         let cos_i = -n.dot(d);
         let reflected = d + n * (2.0 * cos_i);
         if self.var.reflective[obj] {
-            self.trace(pixel, p + n * EPS * 10.0, reflected, index, Via::Reflect, depth + 1);
+            self.trace(
+                pixel,
+                p + n * EPS * 10.0,
+                reflected,
+                index,
+                Via::Reflect,
+                depth + 1,
+            );
         }
         if self.var.transmissive[obj] {
             let ior = self.scene.objects[obj].material.ior;
@@ -181,7 +231,14 @@ impl Tracer<'_> {
             } else {
                 (d * eta + n * (eta * cos_i - k.sqrt()), p - n * EPS * 10.0)
             };
-            self.trace(pixel, start, dir.normalized(), index, Via::Transmit, depth + 1);
+            self.trace(
+                pixel,
+                start,
+                dir.normalized(),
+                index,
+                Via::Transmit,
+                depth + 1,
+            );
         }
     }
 
@@ -199,7 +256,9 @@ impl Tracer<'_> {
                     return Shadow::Dark;
                 }
                 let o = p + n * EPS * 10.0;
-                let blocked = (0..g.prims.len()).filter(others).any(|i| g.prims[i].hits_before(o, d, dist));
+                let blocked = (0..g.prims.len())
+                    .filter(others)
+                    .any(|i| g.prims[i].hits_before(o, d, dist));
                 if blocked {
                     Shadow::Dark
                 } else {
@@ -212,7 +271,9 @@ impl Tracer<'_> {
                     return Shadow::Dark;
                 }
                 let o = p + n * EPS * 10.0;
-                let blocked = (0..g.prims.len()).filter(others).any(|i| g.prims[i].hits_before(o, d, f64::INFINITY));
+                let blocked = (0..g.prims.len())
+                    .filter(others)
+                    .any(|i| g.prims[i].hits_before(o, d, f64::INFINITY));
                 if blocked {
                     Shadow::Dark
                 } else {
@@ -221,7 +282,12 @@ impl Tracer<'_> {
             }
             (_, LightRange::Moving(lo, hi)) => {
                 let start = self.occluders.len() as u32;
-                self.occluders.extend((0..g.prims.len()).filter(others).filter(|&i| g.prims[i].may_block(p, lo, hi)).map(|i| g.occluder(i as u32, p)));
+                self.occluders.extend(
+                    (0..g.prims.len())
+                        .filter(others)
+                        .filter(|&i| g.prims[i].may_block(p, lo, hi))
+                        .map(|i| g.occluder(i as u32, p)),
+                );
                 let len = self.occluders.len() as u32 - start;
                 if len == 0 {
                     Shadow::Lit
@@ -231,7 +297,11 @@ impl Tracer<'_> {
             }
             (_, LightRange::Turning) => {
                 let start = self.occluders.len() as u32;
-                self.occluders.extend((0..g.prims.len()).filter(others).map(|i| g.occluder(i as u32, p)));
+                self.occluders.extend(
+                    (0..g.prims.len())
+                        .filter(others)
+                        .map(|i| g.occluder(i as u32, p)),
+                );
                 let len = self.occluders.len() as u32 - start;
                 if len == 0 {
                     Shadow::Lit
@@ -250,9 +320,20 @@ mod tests {
         let scene = crate::scene::load(std::path::Path::new("scenes/paper_box.json")).unwrap();
         let space = crate::scene::ParamSpace::from_scene(&scene);
         let p = super::Paths::build(&scene, &super::Variation::new(&scene, &space));
-        eprintln!("verts {} occluders {} prims {}", p.verts.len(), p.occluders.len(), p.geometry.prims.len());
+        eprintln!(
+            "verts {} occluders {} prims {}",
+            p.verts.len(),
+            p.occluders.len(),
+            p.geometry.prims.len()
+        );
         let mut hist = std::collections::BTreeMap::new();
-        for s in &p.shadow { if let super::Shadow::Test{len,..} = s { *hist.entry(*len).or_insert(0) += 1; } else { *hist.entry(99).or_insert(0) += 1; } }
+        for s in &p.shadow {
+            if let super::Shadow::Test { len, .. } = s {
+                *hist.entry(*len).or_insert(0) += 1;
+            } else {
+                *hist.entry(99).or_insert(0) += 1;
+            }
+        }
         eprintln!("{hist:?}");
     }
 }

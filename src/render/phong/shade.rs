@@ -1,13 +1,21 @@
 //! Shading of the cached ray hits for one candidate: the Phong-Blinn model
 //! stated in docs/renderers.md, in linear radiance, then sRGB-encoded.
 //!
-//! L = kd*c*A + sum over lights (V * E * (kd*c/pi + ks*(n+8)/(8 pi) * max(0, N.H)^n))
+//! ```text
+//! L = kd*c*A + sum over lights  V * E * (kd*c/pi + ks*(n+8)/(8 pi) * max(0, N.H)^n)
 //!   + kr * L(reflected) + kt * L(refracted)
+//! ```
 //! with E = I*color*cos(theta)/d^2 (point, inverse square), I*color*cos(theta)
-//! (point, no falloff) or E*color*cos(theta) (directional); V the hard-shadow
-//! visibility.
+//! (point, no falloff) or E*color*cos(theta) (directional), and V the
+//! hard-shadow visibility.
+//!
+//! The per-light pass over all hits is written as plain loops over arrays
+//! so that the compiler vectorises it; on CPUs with AVX2 a copy compiled for
+//! it is chosen at run time.
 
-use super::paths::{Paths, Shadow, Via, NO_PARENT};
+use super::geometry::Geometry;
+use super::packed::{LightPack, Packed};
+use super::paths::{Paths, Via, NO_PARENT};
 use crate::math::V3;
 use crate::render::srgb::Encoder;
 use crate::scene::{Falloff, LightKind, Scene};
@@ -17,124 +25,259 @@ use std::f64::consts::PI;
 const SPEC_CUTOFF: f64 = 1e-5;
 
 struct Mat {
-    diffuse: V3,
-    ambient: V3,
-    spec: f64,
-    shininess: f64,
+    diffuse: [f32; 3],
+    ambient: [f32; 3],
+    spec: f32,
+    shininess: f32,
     /// Below this N.H the specular lobe is negligible.
-    min_cos: f64,
+    min_cos: f32,
     reflection: f64,
     transmission: f64,
 }
 
+/// A light for one candidate.
 struct Lamp {
     point: bool,
     inverse_square: bool,
     /// Position (point) or unit direction towards the light.
-    at: V3,
-    power: V3,
+    at: [f32; 3],
+    power: [f32; 3],
 }
 
-/// Renders `scene` from its cached `paths` into 8-bit sRGB RGB bytes.
-pub fn shade(paths: &Paths, scene: &Scene, enc: &Encoder, out: &mut [u8]) {
+/// Renders `scene` from its cached hits into 8-bit sRGB RGB bytes.
+pub fn shade(paths: &Paths, packed: &Packed, scene: &Scene, enc: &Encoder, out: &mut [u8]) {
+    let mats = materials(scene);
+    let n = packed.n;
+    let (mut r, mut g, mut b) = (vec![0f32; n], vec![0f32; n], vec![0f32; n]);
+    for grp in &packed.groups {
+        let a = mats[grp.object as usize].ambient;
+        r[grp.start..grp.end].fill(a[0]);
+        g[grp.start..grp.end].fill(a[1]);
+        b[grp.start..grp.end].fill(a[2]);
+    }
+    let mut e = vec![0f32; n];
+    let mut nh = vec![0f32; n];
+    for (l, light) in scene.lights.iter().enumerate() {
+        let lamp = lamp(light);
+        if lamp.power == [0.0; 3] {
+            continue;
+        }
+        irradiance(packed, &packed.lights[l], &lamp, &mut e, &mut nh);
+        complex_shadows(paths, &paths.geometry, l, &packed.lights[l], &lamp, &mut e);
+        for grp in &packed.groups {
+            let m = &mats[grp.object as usize];
+            let range = grp.start..grp.end;
+            let k = [
+                m.diffuse[0] * lamp.power[0],
+                m.diffuse[1] * lamp.power[1],
+                m.diffuse[2] * lamp.power[2],
+            ];
+            accumulate(
+                &e[range.clone()],
+                k,
+                &mut r[range.clone()],
+                &mut g[range.clone()],
+                &mut b[range.clone()],
+            );
+            if m.spec > 0.0 {
+                for i in range {
+                    if e[i] > 0.0 && nh[i] > m.min_cos {
+                        let s = m.spec * nh[i].powf(m.shininess) * e[i];
+                        r[i] += s * lamp.power[0];
+                        g[i] += s * lamp.power[1];
+                        b[i] += s * lamp.power[2];
+                    }
+                }
+            }
+        }
+    }
+    match &packed.direct_pixel {
+        Some(pixel) => {
+            for i in 0..n {
+                let px = pixel[i] as usize * 3;
+                out[px] = enc.encode(r[i]);
+                out[px + 1] = enc.encode(g[i]);
+                out[px + 2] = enc.encode(b[i]);
+            }
+        }
+        None => {
+            // Weights flow from each hit to the hits its mirror and glass
+            // rays made; parents come before children in trace order.
+            let npix = (paths.width * paths.height) as usize;
+            let mut acc = vec![V3::ZERO; npix];
+            let mut weight = vec![0f64; paths.verts.len()];
+            let sample_weight = 1.0 / paths.samples_per_pixel as f64;
+            for (vi, vert) in paths.verts.iter().enumerate() {
+                let w = if vert.parent == NO_PARENT {
+                    sample_weight
+                } else {
+                    let pm = &mats[paths.verts[vert.parent as usize].object as usize];
+                    weight[vert.parent as usize]
+                        * match vert.via {
+                            Via::Reflect => pm.reflection,
+                            Via::Transmit => pm.transmission,
+                            Via::Camera => 1.0,
+                        }
+                };
+                weight[vi] = w;
+                let k = packed.packed_of[vi] as usize;
+                acc[vert.pixel as usize] += V3::new(r[k] as f64, g[k] as f64, b[k] as f64) * w;
+            }
+            for (px, c) in acc.iter().enumerate() {
+                out[3 * px] = enc.encode(c.x as f32);
+                out[3 * px + 1] = enc.encode(c.y as f32);
+                out[3 * px + 2] = enc.encode(c.z as f32);
+            }
+        }
+    }
+}
+
+fn materials(scene: &Scene) -> Vec<Mat> {
     let ambient = V3::from(scene.ambient);
-    let mats: Vec<Mat> = scene
+    scene
         .objects
         .iter()
         .map(|o| {
             let m = &o.material;
             let albedo = V3::from(m.color) * m.diffuse;
+            let d = albedo / PI;
+            let a = albedo.mul_elem(ambient);
             Mat {
-                diffuse: albedo / PI,
-                ambient: albedo.mul_elem(ambient),
-                spec: m.specular * (m.shininess + 8.0) / (8.0 * PI),
-                shininess: m.shininess,
-                min_cos: SPEC_CUTOFF.powf(1.0 / m.shininess),
+                diffuse: [d.x as f32, d.y as f32, d.z as f32],
+                ambient: [a.x as f32, a.y as f32, a.z as f32],
+                spec: (m.specular * (m.shininess + 8.0) / (8.0 * PI)) as f32,
+                shininess: m.shininess as f32,
+                min_cos: SPEC_CUTOFF.powf(1.0 / m.shininess) as f32,
                 reflection: m.reflection,
                 transmission: m.transmission,
             }
         })
-        .collect();
-    let lamps: Vec<Lamp> = scene
-        .lights
-        .iter()
-        .map(|l| Lamp {
-            point: l.kind == LightKind::Point,
-            inverse_square: l.falloff == Falloff::InverseSquare,
-            at: match l.kind {
-                LightKind::Point => V3::from(l.position.unwrap_or_default()),
-                LightKind::Directional => V3::from(l.direction.unwrap_or([0.0, 1.0, 0.0])).normalized(),
-            },
-            power: V3::from(l.color) * l.intensity,
-        })
-        .collect();
-    let nl = lamps.len();
-    let npix = (paths.width * paths.height) as usize;
-    let mut acc = vec![V3::ZERO; npix];
-    let mut weight = vec![0.0f64; paths.verts.len()];
-    let sample_weight = 1.0 / paths.samples_per_pixel as f64;
-    let g = &paths.geometry;
-    for (vi, vert) in paths.verts.iter().enumerate() {
-        let w = if vert.parent == NO_PARENT {
-            sample_weight
-        } else {
-            let parent = &paths.verts[vert.parent as usize];
-            let pm = &mats[parent.object as usize];
-            weight[vert.parent as usize]
-                * match vert.via {
-                    Via::Reflect => pm.reflection,
-                    Via::Transmit => pm.transmission,
-                    Via::Camera => 1.0,
-                }
-        };
-        weight[vi] = w;
-        if w == 0.0 {
+        .collect()
+}
+
+fn lamp(l: &crate::scene::Light) -> Lamp {
+    let at = match l.kind {
+        LightKind::Point => V3::from(l.position.unwrap_or_default()),
+        LightKind::Directional => V3::from(l.direction.unwrap_or([0.0, 1.0, 0.0])).normalized(),
+    };
+    let p = V3::from(l.color) * l.intensity;
+    Lamp {
+        point: l.kind == LightKind::Point,
+        inverse_square: l.falloff == Falloff::InverseSquare,
+        at: [at.x as f32, at.y as f32, at.z as f32],
+        power: [p.x as f32, p.y as f32, p.z as f32],
+    }
+}
+
+/// For every hit: e = V * cos(theta) * falloff, and N.H for the specular lobe.
+fn irradiance(pk: &Packed, lp: &LightPack, lamp: &Lamp, e: &mut [f32], nh: &mut [f32]) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        if std::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU has AVX2, checked just above.
+            unsafe { irradiance_avx2(pk, lp, lamp, e, nh) };
+            return;
+        }
+    }
+    irradiance_kernel(pk, lp, lamp, e, nh);
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn irradiance_avx2(pk: &Packed, lp: &LightPack, lamp: &Lamp, e: &mut [f32], nh: &mut [f32]) {
+    irradiance_kernel(pk, lp, lamp, e, nh);
+}
+
+#[inline(always)]
+fn irradiance_kernel(pk: &Packed, lp: &LightPack, lamp: &Lamp, e: &mut [f32], nh: &mut [f32]) {
+    let n = pk.n;
+    let (px, py, pz) = (&pk.px[..n], &pk.py[..n], &pk.pz[..n]);
+    let (nx, ny, nz) = (&pk.nx[..n], &pk.ny[..n], &pk.nz[..n]);
+    let (vx, vy, vz) = (&pk.vx[..n], &pk.vy[..n], &pk.vz[..n]);
+    let (qx, qy, qz, qc, vis) = (
+        &lp.qx[..n],
+        &lp.qy[..n],
+        &lp.qz[..n],
+        &lp.qc[..n],
+        &lp.vis[..n],
+    );
+    let (e, nh) = (&mut e[..n], &mut nh[..n]);
+    let [lx, ly, lz] = lamp.at;
+    let inverse_square = lamp.inverse_square;
+    if lamp.point {
+        for i in 0..n {
+            let (tx, ty, tz) = (lx - px[i], ly - py[i], lz - pz[i]);
+            let d2 = tx * tx + ty * ty + tz * tz;
+            let d = d2.sqrt();
+            let inv = 1.0 / d;
+            let (dx, dy, dz) = (tx * inv, ty * inv, tz * inv);
+            let cos = (nx[i] * dx + ny[i] * dy + nz[i] * dz).max(0.0);
+            // The sphere blocks when the ray meets it in front of the light.
+            let b = qx[i] * dx + qy[i] * dy + qz[i] * dz;
+            let disc = b * b - qc[i];
+            let blocked = b > 0.0 && disc > 0.0 && b - disc.max(0.0).sqrt() < d;
+            let fall = if inverse_square { inv * inv } else { 1.0 };
+            e[i] = if blocked { 0.0 } else { cos * fall * vis[i] };
+            let (hx, hy, hz) = (dx + vx[i], dy + vy[i], dz + vz[i]);
+            let h2 = hx * hx + hy * hy + hz * hz;
+            nh[i] = (nx[i] * hx + ny[i] * hy + nz[i] * hz) / h2.sqrt();
+        }
+    } else {
+        let (dx, dy, dz) = (lx, ly, lz);
+        for i in 0..n {
+            let cos = (nx[i] * dx + ny[i] * dy + nz[i] * dz).max(0.0);
+            let b = qx[i] * dx + qy[i] * dy + qz[i] * dz;
+            let disc = b * b - qc[i];
+            let blocked = b > 0.0 && disc > 0.0;
+            e[i] = if blocked { 0.0 } else { cos * vis[i] };
+            let (hx, hy, hz) = (dx + vx[i], dy + vy[i], dz + vz[i]);
+            let h2 = hx * hx + hy * hy + hz * hz;
+            nh[i] = (nx[i] * hx + ny[i] * hy + nz[i] * hz) / h2.sqrt();
+        }
+    }
+}
+
+/// Hits with several possible blockers, or blockers other than spheres:
+/// the general shadow-ray test.
+fn complex_shadows(
+    paths: &Paths,
+    geo: &Geometry,
+    l: usize,
+    lp: &LightPack,
+    lamp: &Lamp,
+    e: &mut [f32],
+) {
+    let nl = paths.shadow.len() / paths.verts.len().max(1);
+    let at = V3::new(lamp.at[0] as f64, lamp.at[1] as f64, lamp.at[2] as f64);
+    for &(k, i) in &lp.complex {
+        let k = k as usize;
+        if e[k] == 0.0 {
             continue;
         }
-        let m = &mats[vert.object as usize];
-        let mut l_out = m.ambient;
-        let shadows = &paths.shadow[vi * nl..vi * nl + nl];
-        for (lamp, shadow) in lamps.iter().zip(shadows) {
-            if *shadow == Shadow::Dark {
-                continue;
+        let vert = &paths.verts[i as usize];
+        let (dir, dist) = if lamp.point {
+            let to = at - vert.p;
+            let d = to.length();
+            (to * (1.0 / d), d)
+        } else {
+            (at, f64::INFINITY)
+        };
+        if let super::paths::Shadow::Test { start, len } = paths.shadow[i as usize * nl + l] {
+            let occ = &paths.occluders[start as usize..(start + len) as usize];
+            if geo.occluded(vert.p + vert.n * 1e-6, dir, dist, occ) {
+                e[k] = 0.0;
             }
-            let (dir, dist, falloff) = if lamp.point {
-                let to = lamp.at - vert.p;
-                let d2 = to.dot(to);
-                let d = d2.sqrt();
-                let inv = 1.0 / d;
-                (to * inv, d, if lamp.inverse_square { inv * inv } else { 1.0 })
-            } else {
-                (lamp.at, f64::INFINITY, 1.0)
-            };
-            let cos = vert.n.dot(dir);
-            if cos <= 0.0 {
-                continue;
-            }
-            if let Shadow::Test { start, len } = *shadow {
-                let cand = &paths.occluders[start as usize..(start + len) as usize];
-                if g.occluded(vert.p + vert.n * 1e-6, dir, dist, cand) {
-                    continue;
-                }
-            }
-            let e = cos * falloff;
-            let mut brdf = m.diffuse;
-            if m.spec > 0.0 {
-                let h = (dir + vert.v).normalized();
-                let nh = vert.n.dot(h);
-                if nh > m.min_cos {
-                    let s = m.spec * nh.powf(m.shininess);
-                    brdf += V3::new(s, s, s);
-                }
-            }
-            l_out += brdf.mul_elem(lamp.power) * e;
         }
-        acc[vert.pixel as usize] += l_out * w;
     }
-    // Mirror and glass contributions were added per vertex; encode.
-    for (px, c) in acc.iter().enumerate() {
-        out[3 * px] = enc.encode(c.x as f32);
-        out[3 * px + 1] = enc.encode(c.y as f32);
-        out[3 * px + 2] = enc.encode(c.z as f32);
+}
+
+#[inline(always)]
+fn accumulate(e: &[f32], k: [f32; 3], r: &mut [f32], g: &mut [f32], b: &mut [f32]) {
+    let n = e.len();
+    let (r, g, b) = (&mut r[..n], &mut g[..n], &mut b[..n]);
+    for i in 0..n {
+        r[i] += e[i] * k[0];
+        g[i] += e[i] * k[1];
+        b[i] += e[i] * k[2];
     }
 }

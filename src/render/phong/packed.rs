@@ -1,0 +1,131 @@
+//! The cached ray hits laid out for fast shading: structure of arrays in
+//! `f32`, grouped by object so that a material is constant over a run of
+//! hits, with each hit's shadow test against its one possible blocking
+//! sphere reduced to four numbers. What does not fit that form (several
+//! possible blockers, quads, turning lights) stays on a short list tested
+//! the general way.
+
+use super::geometry::Occluder;
+use super::paths::{Paths, Shadow, NO_PARENT};
+
+/// A run of hits on one object.
+pub struct Group {
+    pub object: u32,
+    pub start: usize,
+    pub end: usize,
+}
+
+/// Shadowing of every hit by one light.
+pub struct LightPack {
+    /// Fixed visibility: 1 lit, 0 always dark.
+    pub vis: Vec<f32>,
+    /// The blocking sphere as seen from the hit: q = centre - hit, and
+    /// qc = |q|^2 - r^2 (+inf: nothing to test).
+    pub qx: Vec<f32>,
+    pub qy: Vec<f32>,
+    pub qz: Vec<f32>,
+    pub qc: Vec<f32>,
+    /// (packed index, trace index) of hits tested the general way.
+    pub complex: Vec<(u32, u32)>,
+}
+
+pub struct Packed {
+    pub n: usize,
+    pub groups: Vec<Group>,
+    /// Packed index of each trace-order vertex.
+    pub packed_of: Vec<u32>,
+    pub px: Vec<f32>,
+    pub py: Vec<f32>,
+    pub pz: Vec<f32>,
+    pub nx: Vec<f32>,
+    pub ny: Vec<f32>,
+    pub nz: Vec<f32>,
+    pub vx: Vec<f32>,
+    pub vy: Vec<f32>,
+    pub vz: Vec<f32>,
+    pub lights: Vec<LightPack>,
+    /// When every hit is a camera hit and pixels have one sample: the pixel
+    /// of each packed hit (no weights to propagate).
+    pub direct_pixel: Option<Vec<u32>>,
+}
+
+impl Packed {
+    pub fn new(paths: &Paths, lights: usize) -> Packed {
+        let n = paths.verts.len();
+        let mut order: Vec<u32> = (0..n as u32).collect();
+        order.sort_by_key(|&i| paths.verts[i as usize].object); // stable: keeps trace order within an object
+        let mut packed_of = vec![0u32; n];
+        for (k, &i) in order.iter().enumerate() {
+            packed_of[i as usize] = k as u32;
+        }
+        let mut groups: Vec<Group> = Vec::new();
+        for (k, &i) in order.iter().enumerate() {
+            let obj = paths.verts[i as usize].object;
+            match groups.last_mut() {
+                Some(g) if g.object == obj => g.end = k + 1,
+                _ => groups.push(Group {
+                    object: obj,
+                    start: k,
+                    end: k + 1,
+                }),
+            }
+        }
+        let col = |f: &dyn Fn(usize) -> f64| -> Vec<f32> {
+            order.iter().map(|&i| f(i as usize) as f32).collect()
+        };
+        let v = &paths.verts;
+        let mut packs = Vec::with_capacity(lights);
+        for l in 0..lights {
+            let mut p = LightPack {
+                vis: vec![1.0; n],
+                qx: vec![0.0; n],
+                qy: vec![0.0; n],
+                qz: vec![0.0; n],
+                qc: vec![f32::INFINITY; n],
+                complex: Vec::new(),
+            };
+            for (k, &i) in order.iter().enumerate() {
+                match paths.shadow[i as usize * lights + l] {
+                    Shadow::Lit => {}
+                    Shadow::Dark => p.vis[k] = 0.0,
+                    Shadow::Test { start, len } => {
+                        let occ = &paths.occluders[start as usize..(start + len) as usize];
+                        match occ {
+                            [Occluder::Cone {
+                                axis,
+                                cos_max,
+                                center_dist,
+                                ..
+                            }] => {
+                                let q = *axis * *center_dist;
+                                p.qx[k] = q.x as f32;
+                                p.qy[k] = q.y as f32;
+                                p.qz[k] = q.z as f32;
+                                p.qc[k] = (center_dist * center_dist * cos_max * cos_max) as f32;
+                            }
+                            _ => p.complex.push((k as u32, i)),
+                        }
+                    }
+                }
+            }
+            packs.push(p);
+        }
+        let direct = paths.samples_per_pixel == 1 && v.iter().all(|x| x.parent == NO_PARENT);
+        Packed {
+            n,
+            groups,
+            px: col(&|i| v[i].p.x),
+            py: col(&|i| v[i].p.y),
+            pz: col(&|i| v[i].p.z),
+            nx: col(&|i| v[i].n.x),
+            ny: col(&|i| v[i].n.y),
+            nz: col(&|i| v[i].n.z),
+            vx: col(&|i| v[i].v.x),
+            vy: col(&|i| v[i].v.y),
+            vz: col(&|i| v[i].v.z),
+            direct_pixel: direct.then(|| order.iter().map(|&i| v[i as usize].pixel).collect()),
+            packed_of,
+            lights: packs,
+        }
+    }
+}
