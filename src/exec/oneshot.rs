@@ -1,0 +1,119 @@
+//! One process per render (POV-Ray, `cmd:TEMPLATE` plug-ins): up to `jobs`
+//! at once, each with a timeout, its output checked, a failure retried once.
+
+use super::process::{kill_group, CommandSpec};
+use super::tail::{drain, Tail};
+use super::{output, pool, ExecConfig};
+use crate::render::{RenderFailure, RenderResult};
+use std::path::PathBuf;
+use std::time::Duration;
+use tokio::runtime::Runtime;
+
+/// One render: the command that makes it and the image it must write.
+#[derive(Clone, Debug)]
+pub struct OneShotJob {
+    pub command: CommandSpec,
+    pub output: PathBuf,
+    pub width: u32,
+    pub height: u32,
+}
+
+/// How long to wait for a finished process's pipes to close: longer only
+/// when something it started still holds them.
+const PIPE_GRACE: Duration = Duration::from_millis(500);
+
+/// Runs `spec` to its end; Ok when it exits with status 0. The error keeps
+/// what it printed.
+pub async fn run_process(spec: &CommandSpec, timeout: Duration) -> Result<String, RenderFailure> {
+    let mut child = spec.spawn(false).map_err(|e| RenderFailure {
+        message: format!("cannot start {}: {e}", spec.display()),
+        stderr: String::new(),
+    })?;
+    let pid = child.id();
+    let tail = Tail::new();
+    let drains: Vec<_> = [
+        drain(child.stdout.take(), tail.clone()),
+        drain(child.stderr.take(), tail.clone()),
+    ]
+    .into_iter()
+    .flatten()
+    .collect();
+    let status = tokio::time::timeout(timeout, child.wait()).await;
+    let mut lingering = false;
+    if status.is_ok() {
+        for d in drains {
+            if tokio::time::timeout(PIPE_GRACE, d).await.is_err() {
+                lingering = true;
+            }
+        }
+    }
+    if status.is_err() || lingering {
+        // timed out, or a child of it still runs: end the whole group
+        kill_group(&mut child, pid);
+        let _ = tokio::time::timeout(Duration::from_secs(5), child.wait()).await;
+    }
+    let text = tail.text();
+    match status {
+        Err(_) => Err(RenderFailure {
+            message: format!("timed out after {} s and was killed", timeout.as_secs_f64()),
+            stderr: text,
+        }),
+        Ok(Err(e)) => Err(RenderFailure {
+            message: format!("lost track of the process: {e}"),
+            stderr: text,
+        }),
+        Ok(Ok(s)) if s.success() => Ok(text),
+        Ok(Ok(s)) => Err(RenderFailure {
+            message: describe_exit(s),
+            stderr: text,
+        }),
+    }
+}
+
+fn describe_exit(s: std::process::ExitStatus) -> String {
+    use std::os::unix::process::ExitStatusExt;
+    match (s.code(), s.signal()) {
+        (Some(c), _) => format!("exited with status {c}"),
+        (None, Some(sig)) => format!("was killed by signal {sig}"),
+        _ => format!("ended with {s}"),
+    }
+}
+
+/// One render with its retries: the process must exit 0 and leave an
+/// image of the right size.
+pub async fn render(job: &OneShotJob, cfg: &ExecConfig) -> RenderResult {
+    let mut failures = Vec::new();
+    for _ in 0..=cfg.retries {
+        output::remove(&job.output);
+        let result = match run_process(&job.command, cfg.render_timeout).await {
+            Ok(text) => {
+                output::read(&job.output, job.width, job.height).map_err(|m| RenderFailure {
+                    message: format!("exited 0 but {m}"),
+                    stderr: text,
+                })
+            }
+            Err(f) => Err(f),
+        };
+        output::remove(&job.output);
+        match result {
+            Ok(img) => return Ok(img),
+            Err(f) => failures.push(f),
+        }
+    }
+    Err(pool::combine(failures))
+}
+
+/// Renders every job, up to `cfg.jobs` processes at once; results in job order.
+pub fn run_batch(rt: &Runtime, cfg: &ExecConfig, jobs: Vec<OneShotJob>) -> Vec<RenderResult> {
+    let runners = vec![(); cfg.jobs.min(jobs.len()).max(1)];
+    let cfg = cfg.clone();
+    let (_, results) = rt.block_on(pool::run_queue(
+        runners,
+        jobs,
+        move |(), job: OneShotJob| {
+            let cfg = cfg.clone();
+            async move { ((), render(&job, &cfg).await) }
+        },
+    ));
+    results
+}

@@ -1,0 +1,287 @@
+//! A pool of persistent workers, each serving one request at a time: a
+//! worker is started when its slot is first used or its predecessor died,
+//! and replaced after `max_renders` renders. A request in flight when a
+//! worker dies or hangs counts as a failure and is retried once on a fresh
+//! worker. Also the queue both pools share: N runners taking jobs in turn.
+
+use super::output;
+use super::process::CommandSpec;
+use super::worker::{RequestError, Worker};
+use super::ExecConfig;
+use crate::render::{RenderFailure, RenderResult};
+use std::collections::VecDeque;
+use std::future::Future;
+use std::path::PathBuf;
+use std::sync::{Arc, Mutex};
+use std::time::Duration;
+use tokio::runtime::Runtime;
+use tokio::task::JoinSet;
+
+/// Runs `jobs` on as many runners as there are `states`; each runner takes
+/// the next job when it is done with the last. Returns the states and the
+/// results in job order. A runner that panics loses its state and its job
+/// (reported as a failure).
+pub async fn run_queue<S, J, F, Fut>(
+    states: Vec<S>,
+    jobs: Vec<J>,
+    f: F,
+) -> (Vec<S>, Vec<RenderResult>)
+where
+    S: Send + 'static,
+    J: Send + 'static,
+    F: Fn(S, J) -> Fut + Clone + Send + Sync + 'static,
+    Fut: Future<Output = (S, RenderResult)> + Send + 'static,
+{
+    let n = jobs.len();
+    let queue = Arc::new(Mutex::new(
+        jobs.into_iter().enumerate().collect::<VecDeque<_>>(),
+    ));
+    let mut set = JoinSet::new();
+    for state in states {
+        let queue = queue.clone();
+        let f = f.clone();
+        set.spawn(async move {
+            let mut state = state;
+            let mut done = Vec::new();
+            loop {
+                let next = queue.lock().unwrap_or_else(|p| p.into_inner()).pop_front();
+                let Some((i, job)) = next else { break };
+                let (s, r) = f(state, job).await;
+                state = s;
+                done.push((i, r));
+            }
+            (state, done)
+        });
+    }
+    let mut states = Vec::new();
+    let mut results: Vec<Option<RenderResult>> = (0..n).map(|_| None).collect();
+    while let Some(joined) = set.join_next().await {
+        if let Ok((state, done)) = joined {
+            states.push(state);
+            for (i, r) in done {
+                results[i] = Some(r);
+            }
+        }
+    }
+    let results = results
+        .into_iter()
+        .map(|r| {
+            r.unwrap_or_else(|| {
+                Err(RenderFailure {
+                    message: "internal error: the render task failed".into(),
+                    stderr: String::new(),
+                })
+            })
+        })
+        .collect();
+    (states, results)
+}
+
+/// One failure from the attempts at a render: the last, and what the
+/// earlier ones said.
+pub fn combine(mut failures: Vec<RenderFailure>) -> RenderFailure {
+    let Some(mut last) = failures.pop() else {
+        return RenderFailure {
+            message: "no attempt was made".into(),
+            stderr: String::new(),
+        };
+    };
+    if !failures.is_empty() {
+        let earlier: Vec<String> = failures.iter().map(|f| f.message.clone()).collect();
+        last.message = format!(
+            "{} (after {} attempts; earlier: {})",
+            last.message,
+            failures.len() + 1,
+            earlier.join("; ")
+        );
+    }
+    last
+}
+
+/// One render for a persistent worker.
+#[derive(Clone, Debug)]
+pub struct WorkerJob {
+    /// The request line, carrying `"id": id`.
+    pub line: String,
+    pub id: u64,
+    pub output: PathBuf,
+    pub width: u32,
+    pub height: u32,
+}
+
+/// A slot of the pool: at most one worker.
+#[derive(Default)]
+struct Slot {
+    worker: Option<Worker>,
+}
+
+/// What the slots share.
+struct Shared {
+    spec: CommandSpec,
+    cfg: ExecConfig,
+}
+
+/// N persistent workers.
+pub struct WorkerPool {
+    shared: Arc<Shared>,
+    slots: Vec<Slot>,
+    /// The first ready line's "renderer".
+    pub renderer: String,
+}
+
+impl WorkerPool {
+    /// Starts `cfg.jobs` workers at once; fails when none starts, with the
+    /// first worker's failure.
+    pub fn start(
+        rt: &Runtime,
+        spec: CommandSpec,
+        cfg: ExecConfig,
+    ) -> Result<WorkerPool, RenderFailure> {
+        let n = cfg.jobs.max(1);
+        let shared = Arc::new(Shared { spec, cfg });
+        let started: Vec<Result<Worker, RenderFailure>> = rt.block_on(async {
+            let mut set = JoinSet::new();
+            for _ in 0..n {
+                let s = shared.clone();
+                set.spawn(async move { Worker::start(&s.spec, s.cfg.startup_timeout).await });
+            }
+            let mut v = Vec::new();
+            while let Some(r) = set.join_next().await {
+                v.push(r.unwrap_or_else(|_| {
+                    Err(RenderFailure {
+                        message: "internal error: worker start-up task failed".into(),
+                        stderr: String::new(),
+                    })
+                }));
+            }
+            v
+        });
+        let mut slots = Vec::new();
+        let mut first_error = None;
+        for r in started {
+            match r {
+                Ok(w) => slots.push(Slot { worker: Some(w) }),
+                Err(f) => {
+                    first_error.get_or_insert(f);
+                    slots.push(Slot::default());
+                }
+            }
+        }
+        let renderer = slots
+            .iter()
+            .find_map(|s| s.worker.as_ref().map(|w| w.renderer.clone()));
+        match renderer {
+            Some(renderer) => Ok(WorkerPool {
+                shared,
+                slots,
+                renderer,
+            }),
+            None => Err(first_error.unwrap_or_else(|| RenderFailure {
+                message: "no worker started".into(),
+                stderr: String::new(),
+            })),
+        }
+    }
+
+    /// Renders every job on the pool's workers; results in job order.
+    pub fn run_batch(&mut self, rt: &Runtime, jobs: Vec<WorkerJob>) -> Vec<RenderResult> {
+        let n = self.slots.len();
+        let slots = std::mem::take(&mut self.slots);
+        let shared = self.shared.clone();
+        let (mut slots, results) = rt.block_on(run_queue(
+            slots,
+            jobs,
+            move |mut slot: Slot, job: WorkerJob| {
+                let shared = shared.clone();
+                async move {
+                    let r = slot.render(&job, &shared).await;
+                    (slot, r)
+                }
+            },
+        ));
+        slots.resize_with(n, Slot::default);
+        self.slots = slots;
+        results
+    }
+
+    /// Kills every worker.
+    pub fn shutdown(&mut self, rt: &Runtime) {
+        let workers: Vec<Worker> = self
+            .slots
+            .iter_mut()
+            .filter_map(|s| s.worker.take())
+            .collect();
+        rt.block_on(async {
+            for w in workers {
+                w.stop().await;
+            }
+        });
+    }
+}
+
+impl Slot {
+    async fn render(&mut self, job: &WorkerJob, shared: &Shared) -> RenderResult {
+        let cfg = &shared.cfg;
+        let mut failures = Vec::new();
+        for _ in 0..=cfg.retries {
+            if self
+                .worker
+                .as_ref()
+                .is_some_and(|w| w.renders >= cfg.max_renders)
+            {
+                // a fresh process bounds whatever the renderer leaks
+                if let Some(w) = self.worker.take() {
+                    w.stop().await;
+                }
+            }
+            if self.worker.is_none() {
+                match Worker::start(&shared.spec, cfg.startup_timeout).await {
+                    Ok(w) => self.worker = Some(w),
+                    Err(f) => {
+                        failures.push(f);
+                        continue;
+                    }
+                }
+            }
+            let Some(w) = self.worker.as_mut() else {
+                continue;
+            };
+            output::remove(&job.output);
+            match w.request(&job.line, job.id, cfg.render_timeout).await {
+                Ok(()) => {
+                    let img = output::read(&job.output, job.width, job.height);
+                    output::remove(&job.output);
+                    match img {
+                        Ok(img) => return Ok(img),
+                        Err(m) => failures.push(RenderFailure {
+                            message: format!("the worker answered ok but {m}"),
+                            stderr: settled_tail(w).await,
+                        }),
+                    }
+                }
+                Err(RequestError::Answered(m)) => {
+                    output::remove(&job.output);
+                    failures.push(RenderFailure {
+                        message: format!("the worker failed: {m}"),
+                        stderr: settled_tail(w).await,
+                    });
+                }
+                Err(RequestError::Dead(m)) => {
+                    let stderr = match self.worker.take() {
+                        Some(w) => w.stop().await,
+                        None => String::new(),
+                    };
+                    output::remove(&job.output);
+                    failures.push(RenderFailure { message: m, stderr });
+                }
+            }
+        }
+        Err(combine(failures))
+    }
+}
+
+/// The worker's output once the lines it printed with its answer are in.
+async fn settled_tail(w: &Worker) -> String {
+    tokio::time::sleep(Duration::from_millis(20)).await;
+    w.tail.text()
+}

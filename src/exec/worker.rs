@@ -1,0 +1,239 @@
+//! One persistent worker process speaking the JSON-lines protocol of
+//! DESIGN.md: it prints `{"ready": true, "renderer": "..."}`, then answers
+//! each request line `{"id": N, ...}` with `{"id": N, "ok": true}` or
+//! `{"id": N, "ok": false, "error": "..."}`. Lines on its stdout that are
+//! not protocol (Blender's banner, a stray print) are kept with its stderr,
+//! not treated as errors.
+
+use super::process::{kill_group, CommandSpec};
+use super::tail::{drain, Tail};
+use crate::render::RenderFailure;
+use serde_json::Value;
+use std::sync::Arc;
+use std::time::Duration;
+use tokio::io::{AsyncBufReadExt, AsyncWriteExt, BufReader};
+use tokio::process::{Child, ChildStdin, ChildStdout};
+use tokio::time::Instant;
+
+/// A running worker, idle between requests.
+pub struct Worker {
+    child: Child,
+    pid: Option<u32>,
+    stdin: ChildStdin,
+    stdout: BufReader<ChildStdout>,
+    pub tail: Arc<Tail>,
+    /// What the ready line said, e.g. "blender 3.4.1".
+    pub renderer: String,
+    /// Requests answered so far.
+    pub renders: usize,
+}
+
+/// Why a request did not succeed.
+#[derive(Debug)]
+pub enum RequestError {
+    /// The worker answered `ok: false`; it is still usable.
+    Answered(String),
+    /// The worker died, hung or broke the protocol; it must be replaced.
+    Dead(String),
+}
+
+/// What a line on the worker's stdout is.
+enum Line {
+    Json(serde_json::Map<String, Value>),
+    Other,
+}
+
+fn classify(line: &str) -> Line {
+    match serde_json::from_str::<Value>(line) {
+        Ok(Value::Object(m)) => Line::Json(m),
+        _ => Line::Other,
+    }
+}
+
+/// Reads one line; None at end of file.
+async fn read_line(r: &mut BufReader<ChildStdout>) -> std::io::Result<Option<String>> {
+    let mut buf = Vec::new();
+    let n = r.read_until(b'\n', &mut buf).await?;
+    if n == 0 {
+        return Ok(None);
+    }
+    Ok(Some(String::from_utf8_lossy(&buf).trim().to_string()))
+}
+
+impl Worker {
+    /// Starts `spec` and waits for its ready line.
+    pub async fn start(spec: &CommandSpec, timeout: Duration) -> Result<Worker, RenderFailure> {
+        let fail = |message: String, stderr: String| RenderFailure { message, stderr };
+        let mut child = spec.spawn(true).map_err(|e| {
+            fail(
+                format!("cannot start worker {}: {e}", spec.display()),
+                String::new(),
+            )
+        })?;
+        let pid = child.id();
+        let tail = Tail::new();
+        drain(child.stderr.take(), tail.clone());
+        let (Some(stdin), Some(stdout)) = (child.stdin.take(), child.stdout.take()) else {
+            kill_group(&mut child, pid);
+            return Err(fail("worker started without pipes".into(), String::new()));
+        };
+        let mut w = Worker {
+            child,
+            pid,
+            stdin,
+            stdout: BufReader::new(stdout),
+            tail,
+            renderer: String::new(),
+            renders: 0,
+        };
+        let deadline = Instant::now() + timeout;
+        loop {
+            match tokio::time::timeout_at(deadline, read_line(&mut w.stdout)).await {
+                Err(_) => {
+                    let msg = format!(
+                        "worker {} did not print its ready line within {} s",
+                        spec.display(),
+                        timeout.as_secs_f64()
+                    );
+                    return Err(fail(msg, w.stop().await));
+                }
+                Ok(Err(e)) => {
+                    return Err(fail(
+                        format!("cannot read from worker {}: {e}", spec.display()),
+                        w.stop().await,
+                    ))
+                }
+                Ok(Ok(None)) => {
+                    let status = w.exit_status().await;
+                    return Err(fail(
+                        format!(
+                            "worker {} exited before it was ready ({status})",
+                            spec.display()
+                        ),
+                        w.stop().await,
+                    ));
+                }
+                Ok(Ok(Some(line))) => match classify(&line) {
+                    Line::Json(m) if m.contains_key("ready") => {
+                        if m.get("ready") == Some(&Value::Bool(true)) {
+                            w.renderer = m
+                                .get("renderer")
+                                .and_then(Value::as_str)
+                                .unwrap_or("")
+                                .to_string();
+                            return Ok(w);
+                        }
+                        let why = m
+                            .get("error")
+                            .and_then(Value::as_str)
+                            .unwrap_or("no reason given")
+                            .to_string();
+                        return Err(fail(
+                            format!("worker {} is not ready: {why}", spec.display()),
+                            w.stop().await,
+                        ));
+                    }
+                    _ if line.is_empty() => {}
+                    _ => w.tail.push_line("[stdout] ", &line),
+                },
+            }
+        }
+    }
+
+    /// Sends one request line (which carries `"id": id`) and waits for its answer.
+    pub async fn request(
+        &mut self,
+        line: &str,
+        id: u64,
+        timeout: Duration,
+    ) -> Result<(), RequestError> {
+        let deadline = Instant::now() + timeout;
+        let sent = tokio::time::timeout_at(deadline, async {
+            self.stdin.write_all(line.as_bytes()).await?;
+            self.stdin.write_all(b"\n").await?;
+            self.stdin.flush().await
+        })
+        .await;
+        match sent {
+            Err(_) => {
+                return Err(RequestError::Dead(format!(
+                    "timed out after {} s (the worker does not read its input)",
+                    timeout.as_secs_f64()
+                )))
+            }
+            Ok(Err(e)) => {
+                let status = self.exit_status().await;
+                return Err(RequestError::Dead(format!(
+                    "cannot send the request ({e}); the worker {status}"
+                )));
+            }
+            Ok(Ok(())) => {}
+        }
+        loop {
+            let line = match tokio::time::timeout_at(deadline, read_line(&mut self.stdout)).await {
+                Err(_) => {
+                    return Err(RequestError::Dead(format!(
+                        "timed out after {} s and was killed",
+                        timeout.as_secs_f64()
+                    )))
+                }
+                Ok(Err(e)) => {
+                    return Err(RequestError::Dead(format!(
+                        "cannot read the worker's answer: {e}"
+                    )))
+                }
+                Ok(Ok(None)) => {
+                    let status = self.exit_status().await;
+                    return Err(RequestError::Dead(format!(
+                        "the worker {status} while rendering"
+                    )));
+                }
+                Ok(Ok(Some(line))) => line,
+            };
+            let Line::Json(m) = classify(&line) else {
+                if !line.is_empty() {
+                    self.tail.push_line("[stdout] ", &line);
+                }
+                continue;
+            };
+            let answer_id = m.get("id");
+            let ours = answer_id.and_then(Value::as_u64) == Some(id);
+            // id null: the worker could not read our request line
+            let unread = matches!(answer_id, None | Some(Value::Null)) && m.contains_key("ok");
+            if !ours && !unread {
+                self.tail
+                    .push_line("[stdout, not an answer to this request] ", &line);
+                continue;
+            }
+            self.renders += 1;
+            if m.get("ok") == Some(&Value::Bool(true)) && ours {
+                return Ok(());
+            }
+            let why = m
+                .get("error")
+                .and_then(Value::as_str)
+                .unwrap_or("answered ok: false without an error message");
+            return Err(RequestError::Answered(why.to_string()));
+        }
+    }
+
+    /// "exited with status N" or "is still running", waiting a moment for it to end.
+    async fn exit_status(&mut self) -> String {
+        match tokio::time::timeout(Duration::from_secs(2), self.child.wait()).await {
+            Ok(Ok(s)) => match s.code() {
+                Some(c) => format!("exited with status {c}"),
+                None => format!("ended ({s})"),
+            },
+            _ => "stopped answering".into(),
+        }
+    }
+
+    /// Kills the worker (and its process group) and returns what it printed.
+    pub async fn stop(mut self) -> String {
+        kill_group(&mut self.child, self.pid);
+        let _ = tokio::time::timeout(Duration::from_secs(5), self.child.wait()).await;
+        // give the stderr drain a moment to collect the last lines
+        tokio::time::sleep(Duration::from_millis(20)).await;
+        self.tail.text()
+    }
+}
