@@ -4,6 +4,7 @@
 
 pub mod cli;
 pub mod error;
+pub mod exec;
 pub mod fit;
 pub mod math;
 pub mod metric;
