@@ -1,0 +1,165 @@
+//! Any program as a renderer (docs/plugins.md):
+//! - `cmd:TEMPLATE`, one process per render: TEMPLATE is split into words
+//!   like a shell would (quotes, backslashes; no shell runs), and `{scene}`,
+//!   `{output}` and `{seed}` are replaced in every word by the scene file
+//!   (JSON, the scene without its `free` list), the PNG to write and the
+//!   sampler seed. Without `{scene}` and `{output}` both are appended.
+//!   Exit 0 and an image of the scene's size, or the render failed.
+//! - `worker:COMMAND`, persistent: COMMAND is started `jobs` times and
+//!   spoken to in JSON lines (the protocol of DESIGN.md).
+//!
+//! Both run in the user's working directory, so relative paths in the
+//! command work as typed. Every scene field is passed through unchanged.
+
+use super::external::{run_dir, ExternalSession, OneShotBackend};
+use super::{RenderSession, Renderer};
+use crate::error::{Error, Result};
+use crate::exec::discover;
+use crate::exec::process::CommandSpec;
+use crate::exec::ExecConfig;
+use crate::scene::{ParamSpace, Scene};
+use std::path::{Path, PathBuf};
+use std::time::Duration;
+
+/// Default per-render timeout of plug-ins (a plug-in's speed is unknown).
+const RENDER_TIMEOUT: Duration = Duration::from_secs(300);
+const STARTUP_TIMEOUT: Duration = Duration::from_secs(120);
+
+const HINT: &str = "give the program's path or put it on PATH";
+
+/// `cmd:TEMPLATE`.
+pub struct OneShotCommand {
+    template: String,
+}
+
+/// `worker:COMMAND`.
+pub struct WorkerCommand {
+    command: String,
+}
+
+impl OneShotCommand {
+    pub fn new(template: &str) -> OneShotCommand {
+        OneShotCommand {
+            template: template.to_string(),
+        }
+    }
+}
+
+impl WorkerCommand {
+    pub fn new(command: &str) -> WorkerCommand {
+        WorkerCommand {
+            command: command.to_string(),
+        }
+    }
+}
+
+/// The words of a command, the program resolved to a full path.
+fn words(spec: &str, what: &str) -> Result<(PathBuf, Vec<String>)> {
+    let words = shell_words::split(spec).map_err(|e| {
+        Error::Usage(format!(
+            "--renderer {what}{spec}: cannot split the command into words: {e}"
+        ))
+    })?;
+    let Some((program, rest)) = words.split_first() else {
+        return Err(Error::Usage(format!(
+            "--renderer {what}: expected a command after \"{what}\""
+        )));
+    };
+    if program.contains('{') {
+        return Err(Error::Usage(format!(
+            "--renderer {what}{spec}: the first word must be the program, got \"{program}\""
+        )));
+    }
+    let path = discover::find(program, HINT)?;
+    // the path must survive a change of working directory
+    let path = std::fs::canonicalize(&path).unwrap_or(path);
+    Ok((path, rest.to_vec()))
+}
+
+impl Renderer for OneShotCommand {
+    fn name(&self) -> String {
+        format!("cmd:{}", self.template)
+    }
+
+    fn session(
+        &self,
+        _base: &Scene,
+        _varying: &ParamSpace,
+        jobs: usize,
+    ) -> Result<Box<dyn RenderSession>> {
+        let (program, mut args) = words(&self.template, "cmd:")?;
+        let has = |p: &str| args.iter().any(|a| a.contains(p));
+        match (has("{scene}"), has("{output}")) {
+            (true, true) => {}
+            (false, false) => args.extend(["{scene}".to_string(), "{output}".to_string()]),
+            _ => {
+                return Err(Error::Usage(format!(
+                    "--renderer cmd:{}: the template needs both {{scene}} and {{output}} (or neither: then they are appended)",
+                    self.template
+                )))
+            }
+        }
+        let cfg = ExecConfig::from_env(jobs, RENDER_TIMEOUT, STARTUP_TIMEOUT)?;
+        let backend = Template { program, args };
+        Ok(Box::new(ExternalSession::one_shot(
+            Box::new(backend),
+            cfg,
+            self.name(),
+            run_dir()?,
+        )?))
+    }
+}
+
+struct Template {
+    program: PathBuf,
+    args: Vec<String>,
+}
+
+impl OneShotBackend for Template {
+    fn prepare(
+        &self,
+        dir: &Path,
+        id: u64,
+        scene: &Scene,
+        seed: u64,
+    ) -> std::result::Result<(CommandSpec, PathBuf), String> {
+        let scene_path = dir.join(format!("r{id}.json"));
+        let output = dir.join(format!("r{id}.png"));
+        let text = serde_json::to_string_pretty(&super::external::plain_scene(scene))
+            .map_err(|e| format!("cannot write the scene: {e}"))?;
+        std::fs::write(&scene_path, text)
+            .map_err(|e| format!("cannot write {}: {e}", scene_path.display()))?;
+        let (sp, op, sd) = (
+            scene_path.to_string_lossy(),
+            output.to_string_lossy(),
+            seed.to_string(),
+        );
+        let args = self.args.iter().map(|a| {
+            a.replace("{scene}", &sp)
+                .replace("{output}", &op)
+                .replace("{seed}", &sd)
+        });
+        Ok((CommandSpec::new(&self.program).args(args), output))
+    }
+}
+
+impl Renderer for WorkerCommand {
+    fn name(&self) -> String {
+        format!("worker:{}", self.command)
+    }
+
+    fn session(
+        &self,
+        _base: &Scene,
+        _varying: &ParamSpace,
+        jobs: usize,
+    ) -> Result<Box<dyn RenderSession>> {
+        let (program, args) = words(&self.command, "worker:")?;
+        let cfg = ExecConfig::from_env(jobs, RENDER_TIMEOUT, STARTUP_TIMEOUT)?;
+        let spec = CommandSpec::new(program).args(args);
+        match ExternalSession::persistent(&self.name(), spec, cfg, run_dir()?) {
+            Ok(s) => Ok(Box::new(s)),
+            Err((e, _)) => Err(e),
+        }
+    }
+}

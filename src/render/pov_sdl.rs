@@ -1,0 +1,298 @@
+//! A scene written as POV-Ray 3.7 scene description language, following
+//! docs/renderers.md ("POV-Ray"), so that POV-Ray renders what the built-in
+//! Phong-Blinn tracer renders.
+//!
+//! Scene fields read, and how they map:
+//! - coordinates: POV-Ray is left-handed; z is mirrored (x, y, z) -> (x, y, -z),
+//!   which keeps the image the same with POV-Ray's left-handed camera.
+//! - `camera`: perspective (`angle` = horizontal field of view computed from
+//!   `fov_y_deg` and the aspect ratio) or orthographic (`up` = height, `right`
+//!   = height * aspect); `position`, `look_at`, `up` (as `sky`).
+//! - `ambient` A: `global_settings { ambient_light A }` and finish
+//!   `ambient kd` (unoccluded, as in Phong).
+//! - `render.max_depth` m: `max_trace_level` m + 1 (POV-Ray counts the camera ray).
+//! - `render.antialias` n > 1: command-line `+A0.0 +AM1 +Rn -J`, see `povray.rs`.
+//! - `render.indirect`: true adds radiosity (POV-Ray's indirect light).
+//! - lights: `point` -> `light_source` with `fade_distance` FADE_DISTANCE,
+//!   `fade_power 2`, colour I*color / (2 FADE_DISTANCE^2) (`inverse_square`),
+//!   or colour I*color without fade (`none`); `radius` r > 0 -> a circular,
+//!   oriented `area_light` of diameter 2r (9x9). `directional` -> a
+//!   `parallel` light 1e6 m away along `direction`, colour E*color.
+//! - objects: `sphere`, `plane`, `quad` (`polygon`), `box`.
+//! - material (kd, ks, n, kr, kt, ior; T = min(kt, MAX_TRANSMIT)):
+//!   pigment `rgbt <color, T>`; finish `ambient kd/(1-T)`,
+//!   `diffuse kd/(pi (1-T))` (POV-Ray's diffuse has no 1/pi and is scaled by
+//!   1-T), `specular ks (n+8)/(8 pi)`, `roughness 1/n` (Blinn's N.H^n),
+//!   `reflection kr`; `interior { ior }` when kt > 0.
+
+use crate::scene::{CameraKind, Falloff, LightKind, Material, Scene, ShapeKind, Vec3};
+use std::f64::consts::PI;
+use std::fmt::Write;
+
+/// `fade_distance` of inverse-square lights, metres. POV-Ray's fade is
+/// 2 / (1 + (d/D)^2); with the colour scaled by 1/(2 D^2) that is
+/// 1 / (d^2 + D^2): within D^2/d^2 = 1e-4 of 1/d^2 at 10 cm from the light.
+pub const FADE_DISTANCE: f64 = 1e-3;
+
+/// The largest transmission POV-Ray can render: its surface shading is
+/// scaled by 1 - transmit, which we undo by dividing; at 1 that is 0/0.
+pub const MAX_TRANSMIT: f64 = 0.999;
+
+/// Distance of the stand-in position of a directional light.
+const PARALLEL_DISTANCE: f64 = 1e6;
+
+/// Mirrors z: scene (right-handed) -> POV-Ray (left-handed).
+fn pov(v: Vec3) -> Vec3 {
+    [v[0], v[1], -v[2]]
+}
+
+fn vec(v: Vec3) -> String {
+    format!("<{}, {}, {}>", num(v[0]), num(v[1]), num(v[2]))
+}
+
+/// A number as POV-Ray reads it (shortest exact decimal; no NaN/inf reach here).
+fn num(x: f64) -> String {
+    if x == 0.0 {
+        "0".into()
+    } else {
+        format!("{x:e}")
+    }
+}
+
+fn rgb(c: Vec3, scale: f64) -> String {
+    format!("rgb {}", vec([c[0] * scale, c[1] * scale, c[2] * scale]))
+}
+
+/// What POV-Ray cannot render of `scene`, if anything.
+pub fn check(scene: &Scene) -> Result<(), String> {
+    if scene.render.max_depth > 254 {
+        return Err(format!(
+            "render.max_depth {}: POV-Ray traces at most 255 levels",
+            scene.render.max_depth
+        ));
+    }
+    Ok(())
+}
+
+/// The scene file POV-Ray renders.
+pub fn sdl(scene: &Scene) -> Result<String, String> {
+    check(scene)?;
+    let mut s = String::with_capacity(4096);
+    let _ = writeln!(
+        s,
+        "// written by scenefit (docs/renderers.md, POV-Ray)\n#version 3.7;"
+    );
+    let _ = writeln!(
+        s,
+        "global_settings {{ assumed_gamma 1.0 max_trace_level {} adc_bailout 0 ambient_light {}{} }}",
+        scene.render.max_depth + 1,
+        rgb(scene.ambient, 1.0),
+        if scene.render.indirect { RADIOSITY } else { "" }
+    );
+    camera(&mut s, scene);
+    for l in &scene.lights {
+        light(&mut s, l)?;
+    }
+    for o in &scene.objects {
+        let sh = &o.shape;
+        let missing = || {
+            format!(
+                "objects.{}.shape: incomplete (the scene was not validated)",
+                o.name
+            )
+        };
+        let shape = match sh.kind {
+            ShapeKind::Sphere => format!(
+                "sphere {{ {}, {}",
+                vec(pov(sh.center.ok_or_else(missing)?)),
+                num(sh.radius.ok_or_else(missing)?)
+            ),
+            ShapeKind::Plane => {
+                let n = normalized(pov(sh.normal.ok_or_else(missing)?)).ok_or_else(missing)?;
+                let p = pov(sh.point.ok_or_else(missing)?);
+                format!("plane {{ {}, {}", vec(n), num(dot(n, p)))
+            }
+            ShapeKind::Quad => {
+                let c = pov(sh.corner.ok_or_else(missing)?);
+                let u = pov(sh.edge_u.ok_or_else(missing)?);
+                let v = pov(sh.edge_v.ok_or_else(missing)?);
+                let p = [c, add(c, u), add(add(c, u), v), add(c, v), c];
+                format!(
+                    "polygon {{ 5, {}",
+                    p.iter().map(|x| vec(*x)).collect::<Vec<_>>().join(", ")
+                )
+            }
+            ShapeKind::Box => {
+                let (lo, hi) = (sh.min.ok_or_else(missing)?, sh.max.ok_or_else(missing)?);
+                format!(
+                    "box {{ {}, {}",
+                    vec([lo[0], lo[1], -hi[2]]),
+                    vec([hi[0], hi[1], -lo[2]])
+                )
+            }
+        };
+        let _ = writeln!(s, "// {}\n{shape}\n  {}\n}}", o.name, material(&o.material));
+    }
+    Ok(s)
+}
+
+/// Radiosity for `render.indirect`: gathered light is the mean radiance
+/// around a point, which POV-Ray multiplies by `diffuse`; ours is kd/pi,
+/// so `brightness` pi makes it kd times the mean radiance, as for a
+/// Lambertian surface.
+const RADIOSITY: &str = "\n  radiosity { pretrace_start 0.08 pretrace_end 0.01 count 200 nearest_count 10 error_bound 0.5 recursion_limit 3 low_error_factor 0.5 gray_threshold 0 minimum_reuse 0.005 brightness 3.14159265358979 adc_bailout 0.001 always_sample off }";
+
+fn camera(s: &mut String, scene: &Scene) {
+    let c = &scene.camera;
+    let aspect = scene.image.width as f64 / scene.image.height as f64;
+    let common = format!("location {} sky {}", vec(pov(c.position)), vec(pov(c.up)));
+    match c.kind {
+        CameraKind::Perspective => {
+            let fov_y = c.fov_y_deg.unwrap_or(40.0).to_radians();
+            let fov_x = 2.0 * ((fov_y / 2.0).tan() * aspect).atan();
+            let _ = writeln!(
+                s,
+                "camera {{ perspective {common} right x*{} up y angle {} look_at {} }}",
+                num(aspect),
+                num(fov_x.to_degrees()),
+                vec(pov(c.look_at))
+            );
+        }
+        CameraKind::Orthographic => {
+            let h = c.height.unwrap_or(1.0);
+            let _ = writeln!(
+                s,
+                "camera {{ orthographic {common} right x*{} up y*{} look_at {} }}",
+                num(h * aspect),
+                num(h),
+                vec(pov(c.look_at))
+            );
+        }
+    }
+}
+
+fn light(s: &mut String, l: &crate::scene::Light) -> Result<(), String> {
+    match l.kind {
+        LightKind::Point => {
+            let p = l
+                .position
+                .ok_or_else(|| format!("lights.{}: a point light needs a position", l.name))?;
+            let (scale, fade) = match l.falloff {
+                Falloff::InverseSquare => (
+                    1.0 / (2.0 * FADE_DISTANCE * FADE_DISTANCE),
+                    format!(" fade_distance {} fade_power 2", num(FADE_DISTANCE)),
+                ),
+                Falloff::None => (1.0, String::new()),
+            };
+            let area = if l.radius > 0.0 {
+                let d = num(2.0 * l.radius);
+                format!(" area_light <{d}, 0, 0>, <0, {d}, 0>, 9, 9 circular orient adaptive 1")
+            } else {
+                String::new()
+            };
+            let _ = writeln!(
+                s,
+                "// {}\nlight_source {{ {} color {}{fade}{area} }}",
+                l.name,
+                vec(pov(p)),
+                rgb(l.color, l.intensity * scale)
+            );
+        }
+        LightKind::Directional => {
+            let d = l.direction.ok_or_else(|| {
+                format!("lights.{}: a directional light needs a direction", l.name)
+            })?;
+            let d = normalized(pov(d))
+                .ok_or_else(|| format!("lights.{}.direction: zero vector", l.name))?;
+            let at = [
+                d[0] * PARALLEL_DISTANCE,
+                d[1] * PARALLEL_DISTANCE,
+                d[2] * PARALLEL_DISTANCE,
+            ];
+            let _ = writeln!(
+                s,
+                "// {}\nlight_source {{ {} color {} parallel point_at <0, 0, 0> }}",
+                l.name,
+                vec(at),
+                rgb(l.color, l.intensity)
+            );
+        }
+    }
+    Ok(())
+}
+
+/// The texture (and interior) of a material, see the module doc.
+fn material(m: &Material) -> String {
+    let t = m.transmission.min(MAX_TRANSMIT);
+    let opacity = 1.0 - t;
+    let c = m.color;
+    let pigment = if t > 0.0 {
+        format!(
+            "rgbt <{}, {}, {}, {}>",
+            num(c[0]),
+            num(c[1]),
+            num(c[2]),
+            num(t)
+        )
+    } else {
+        rgb(c, 1.0)
+    };
+    let mut finish = format!(
+        "ambient {} diffuse {}",
+        num(m.diffuse / opacity),
+        num(m.diffuse / (PI * opacity))
+    );
+    if m.specular > 0.0 {
+        let ks = m.specular * (m.shininess + 8.0) / (8.0 * PI);
+        let _ = write!(
+            finish,
+            " specular {} roughness {}",
+            num(ks),
+            num(1.0 / m.shininess.max(1e-9))
+        );
+    }
+    if m.reflection > 0.0 {
+        let _ = write!(finish, " reflection {{ {} }}", num(m.reflection));
+    }
+    let interior = if t > 0.0 {
+        format!(" interior {{ ior {} }}", num(m.ior))
+    } else {
+        String::new()
+    };
+    format!("texture {{ pigment {{ {pigment} }} finish {{ {finish} }} }}{interior}")
+}
+
+fn dot(a: Vec3, b: Vec3) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+fn add(a: Vec3, b: Vec3) -> Vec3 {
+    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
+}
+
+fn normalized(v: Vec3) -> Option<Vec3> {
+    let l = dot(v, v).sqrt();
+    (l > 0.0 && l.is_finite()).then(|| [v[0] / l, v[1] / l, v[2] / l])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn numbers_povray_reads() {
+        assert_eq!(num(0.0), "0");
+        assert_eq!(num(1.5), "1.5e0");
+        assert_eq!(num(-2e-7), "-2e-7");
+    }
+
+    #[test]
+    fn fade_is_inverse_square() {
+        // colour * 2 / (1 + (d/D)^2) against 1/d^2
+        for d in [0.1f64, 1.0, 10.0] {
+            let pov = 1.0 / (2.0 * FADE_DISTANCE * FADE_DISTANCE) * 2.0
+                / (1.0 + (d / FADE_DISTANCE).powi(2));
+            assert!((pov * d * d - 1.0).abs() <= 1e-4, "{d}: {pov}");
+        }
+    }
+}

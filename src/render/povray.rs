@@ -1,0 +1,134 @@
+//! The POV-Ray 3.7 backend: each render is one `povray` process (one thread,
+//! `+WT1`) reading a scene written by `pov_sdl.rs`; many run at once, since a
+//! render is mostly start-up wait (~0.7 s of wall time, ~0.02 s of CPU).
+//!
+//! Scene fields: everything `pov_sdl.rs` lists, plus `image` (`+W +H`) and
+//! `render.antialias` n: n > 1 supersamples every pixel on an n x n grid
+//! (`+A0.0 +AM1 +Rn -J`; POV-Ray adds the pixel centre, so the centre
+//! weighs 2/(n^2+1) instead of 1/n^2), n = 1 one ray through the pixel
+//! centre (`-A`), as the built-in tracer does. `render.samples` and the
+//! sampler seed are unused: POV-Ray is deterministic.
+
+use super::external::{run_dir, ExternalSession, OneShotBackend};
+use super::{pov_sdl, RenderSession, Renderer};
+use crate::error::{Error, Result};
+use crate::exec::discover;
+use crate::exec::process::CommandSpec;
+use crate::exec::ExecConfig;
+use crate::scene::{ParamSpace, Scene};
+use std::path::{Path, PathBuf};
+use std::time::Duration;
+
+/// Default per-render timeout: a render takes about a second, several
+/// when 64 share two cores.
+const RENDER_TIMEOUT: Duration = Duration::from_secs(120);
+
+/// Processes at once by default: measured on 2 cores (docs/benchmarks-backends.md).
+pub const DEFAULT_JOBS: usize = 64;
+
+/// The POV-Ray backend.
+pub struct PovRay;
+
+impl Renderer for PovRay {
+    fn name(&self) -> String {
+        "povray".into()
+    }
+
+    fn default_jobs(&self) -> usize {
+        DEFAULT_JOBS
+    }
+
+    fn session(
+        &self,
+        base: &Scene,
+        _varying: &ParamSpace,
+        jobs: usize,
+    ) -> Result<Box<dyn RenderSession>> {
+        pov_sdl::check(base).map_err(|m| Error::Usage(format!("povray: {m}")))?;
+        let program = discover::find("povray", &discover::apt_hint("povray"))?;
+        let cfg = ExecConfig::from_env(jobs, RENDER_TIMEOUT, RENDER_TIMEOUT)?;
+        let version = version(&program);
+        let backend = PovBackend { program };
+        Ok(Box::new(ExternalSession::one_shot(
+            Box::new(backend),
+            cfg,
+            version,
+            run_dir()?,
+        )?))
+    }
+}
+
+struct PovBackend {
+    program: PathBuf,
+}
+
+impl OneShotBackend for PovBackend {
+    fn prepare(
+        &self,
+        dir: &Path,
+        id: u64,
+        scene: &Scene,
+        _seed: u64,
+    ) -> std::result::Result<(CommandSpec, PathBuf), String> {
+        let text = pov_sdl::sdl(scene)?;
+        let input = format!("r{id}.pov");
+        let output = format!("r{id}.png");
+        std::fs::write(dir.join(&input), text)
+            .map_err(|e| format!("cannot write {}: {e}", dir.join(&input).display()))?;
+        let spec = CommandSpec::new(&self.program)
+            .cwd(dir)
+            .args(arguments(scene, &input, &output));
+        Ok((spec, dir.join(output)))
+    }
+}
+
+/// The command line of one render (relative paths: POV-Ray may write only
+/// in its working directory and /tmp by default).
+pub fn arguments(scene: &Scene, input: &str, output: &str) -> Vec<String> {
+    let mut a = vec![
+        format!("+I{input}"),
+        format!("+O{output}"),
+        format!("+W{}", scene.image.width),
+        format!("+H{}", scene.image.height),
+        "+FN".into(), // PNG, 8 bits, sRGB-encoded (file_gamma defaults to sRGB)
+        "-D".into(),  // no display
+        "-P".into(),  // no pause
+        "+Q9".into(),
+        "+WT1".into(), // one thread: many processes run at once instead
+        "-GS".into(),  // no statistics, render progress or debug text
+        "-GR".into(),
+        "-GD".into(),
+        "-RVP".into(), // no radiosity preview
+    ];
+    let n = scene.render.antialias.max(1);
+    if n > 1 {
+        a.extend(["+A0.0".into(), "+AM1".into(), format!("+R{n}"), "-J".into()]);
+    } else {
+        a.push("-A".into());
+    }
+    a
+}
+
+/// "povray 3.7.0.10" from `povray --version`, or "povray".
+fn version(program: &Path) -> String {
+    let out = std::process::Command::new(program)
+        .arg("--version")
+        .stdin(std::process::Stdio::null())
+        .output();
+    let text = out
+        .map(|o| {
+            format!(
+                "{}{}",
+                String::from_utf8_lossy(&o.stdout),
+                String::from_utf8_lossy(&o.stderr)
+            )
+        })
+        .unwrap_or_default();
+    text.lines()
+        .find_map(|l| {
+            l.trim()
+                .strip_prefix("POV-Ray ")
+                .map(|v| format!("povray {}", v.trim()))
+        })
+        .unwrap_or_else(|| "povray".into())
+}
