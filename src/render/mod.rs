@@ -7,6 +7,13 @@ pub mod image_io;
 pub mod phong;
 pub mod srgb;
 
+pub mod blender;
+pub mod command;
+pub mod external;
+pub mod mitsuba;
+pub mod pov_sdl;
+pub mod povray;
+
 use crate::error::{Error, Result};
 use crate::scene::{ParamSpace, Scene};
 
@@ -70,6 +77,11 @@ pub trait RenderSession: Send {
 pub fn from_spec(spec: &str) -> Result<Box<dyn Renderer>> {
     match spec {
         "phong" => Ok(Box::new(phong::Phong)),
+        "povray" => Ok(Box::new(povray::PovRay)),
+        "blender" => Ok(Box::new(blender::Blender)),
+        "mitsuba" => Ok(Box::new(mitsuba::Mitsuba)),
+        s if s.starts_with("cmd:") => Ok(Box::new(command::OneShotCommand::new(&s["cmd:".len()..]))),
+        s if s.starts_with("worker:") => Ok(Box::new(command::WorkerCommand::new(&s["worker:".len()..]))),
         other => Err(Error::Usage(format!(
             "--renderer {other}: unknown renderer; expected phong, povray, blender, mitsuba, cmd:TEMPLATE or worker:COMMAND"
         ))),
