@@ -18,7 +18,6 @@ mod packed;
 mod paths;
 mod shade;
 
-use super::srgb::Encoder;
 use super::{Image, RenderResult, RenderSession, Renderer};
 use crate::error::{Error, Result};
 use crate::scene::{ParamSpace, Scene};
@@ -56,7 +55,6 @@ impl Renderer for Phong {
             pool,
             variation,
             cached,
-            encoder: Encoder::new(),
         }))
     }
 }
@@ -79,7 +77,6 @@ struct PhongSession {
     pool: rayon::ThreadPool,
     variation: Variation,
     cached: Option<Arc<Prepared>>,
-    encoder: Encoder,
 }
 
 impl PhongSession {
@@ -87,10 +84,10 @@ impl PhongSession {
         let (w, h) = (scene.image.width, scene.image.height);
         let mut buf = vec![0u8; (w * h * 3) as usize];
         match &self.cached {
-            Some(p) => shade::shade(&p.paths, &p.packed, scene, &self.encoder, &mut buf),
+            Some(p) => shade::shade(&p.paths, &p.packed, scene, &mut buf),
             None => {
                 let p = Prepared::new(scene, &self.variation);
-                shade::shade(&p.paths, &p.packed, scene, &self.encoder, &mut buf)
+                shade::shade(&p.paths, &p.packed, scene, &mut buf)
             }
         }
         Ok(Image::from_raw(w, h, buf).expect("buffer sized to the image"))

@@ -17,7 +17,7 @@ use super::geometry::Geometry;
 use super::packed::{LightPack, Packed};
 use super::paths::{Paths, Via, NO_PARENT};
 use crate::math::V3;
-use crate::render::srgb::Encoder;
+use crate::render::srgb::encode_slice;
 use crate::scene::{Falloff, LightKind, Scene};
 use std::f64::consts::PI;
 
@@ -44,26 +44,61 @@ struct Lamp {
     power: [f32; 3],
 }
 
+/// Per-thread working arrays, kept between renders: allocating them anew
+/// each time costs page faults that showed up as a fifth of a fit's time.
+#[derive(Default)]
+struct Scratch {
+    r: Vec<f32>,
+    g: Vec<f32>,
+    b: Vec<f32>,
+    e: Vec<f32>,
+    nh: Vec<f32>,
+}
+
+thread_local! {
+    static SCRATCH: std::cell::RefCell<Scratch> = std::cell::RefCell::new(Scratch::default());
+}
+
 /// Renders `scene` from its cached hits into 8-bit sRGB RGB bytes.
-pub fn shade(paths: &Paths, packed: &Packed, scene: &Scene, enc: &Encoder, out: &mut [u8]) {
+pub fn shade(paths: &Paths, packed: &Packed, scene: &Scene, out: &mut [u8]) {
+    SCRATCH.with(|cell| {
+        let mut guard = cell.borrow_mut();
+        let Scratch { r, g, b, e, nh } = &mut *guard;
+        for v in [&mut *r, &mut *g, &mut *b, &mut *e, &mut *nh] {
+            v.clear();
+            v.resize(packed.n, 0.0);
+        }
+        shade_into(paths, packed, scene, out, r, g, b, e, nh);
+    })
+}
+
+#[allow(clippy::too_many_arguments)]
+fn shade_into(
+    paths: &Paths,
+    packed: &Packed,
+    scene: &Scene,
+    out: &mut [u8],
+    r: &mut [f32],
+    g: &mut [f32],
+    b: &mut [f32],
+    e: &mut [f32],
+    nh: &mut [f32],
+) {
     let mats = materials(scene);
     let n = packed.n;
-    let (mut r, mut g, mut b) = (vec![0f32; n], vec![0f32; n], vec![0f32; n]);
     for grp in &packed.groups {
         let a = mats[grp.object as usize].ambient;
         r[grp.start..grp.end].fill(a[0]);
         g[grp.start..grp.end].fill(a[1]);
         b[grp.start..grp.end].fill(a[2]);
     }
-    let mut e = vec![0f32; n];
-    let mut nh = vec![0f32; n];
     for (l, light) in scene.lights.iter().enumerate() {
         let lamp = lamp(light);
         if lamp.power == [0.0; 3] {
             continue;
         }
-        irradiance(packed, &packed.lights[l], &lamp, &mut e, &mut nh);
-        complex_shadows(paths, &paths.geometry, l, &packed.lights[l], &lamp, &mut e);
+        irradiance(packed, &packed.lights[l], &lamp, e, nh);
+        complex_shadows(paths, &paths.geometry, l, &packed.lights[l], &lamp, e);
         for grp in &packed.groups {
             let m = &mats[grp.object as usize];
             let range = grp.start..grp.end;
@@ -93,18 +128,25 @@ pub fn shade(paths: &Paths, packed: &Packed, scene: &Scene, enc: &Encoder, out: 
     }
     match &packed.direct_pixel {
         Some(pixel) => {
+            // Encode in hit order (vectorised), then place the bytes.
+            let mut codes = vec![0u8; 3 * n];
+            let (cr, rest) = codes.split_at_mut(n);
+            let (cg, cb) = rest.split_at_mut(n);
+            encode_slice(r, cr);
+            encode_slice(g, cg);
+            encode_slice(b, cb);
             for i in 0..n {
                 let px = pixel[i] as usize * 3;
-                out[px] = enc.encode(r[i]);
-                out[px + 1] = enc.encode(g[i]);
-                out[px + 2] = enc.encode(b[i]);
+                out[px] = cr[i];
+                out[px + 1] = cg[i];
+                out[px + 2] = cb[i];
             }
         }
         None => {
             // Weights flow from each hit to the hits its mirror and glass
             // rays made; parents come before children in trace order.
             let npix = (paths.width * paths.height) as usize;
-            let mut acc = vec![V3::ZERO; npix];
+            let mut acc = vec![0f32; 3 * npix];
             let mut weight = vec![0f64; paths.verts.len()];
             let sample_weight = 1.0 / paths.samples_per_pixel as f64;
             for (vi, vert) in paths.verts.iter().enumerate() {
@@ -121,13 +163,12 @@ pub fn shade(paths: &Paths, packed: &Packed, scene: &Scene, enc: &Encoder, out: 
                 };
                 weight[vi] = w;
                 let k = packed.packed_of[vi] as usize;
-                acc[vert.pixel as usize] += V3::new(r[k] as f64, g[k] as f64, b[k] as f64) * w;
+                let px = vert.pixel as usize * 3;
+                acc[px] += r[k] * w as f32;
+                acc[px + 1] += g[k] * w as f32;
+                acc[px + 2] += b[k] * w as f32;
             }
-            for (px, c) in acc.iter().enumerate() {
-                out[3 * px] = enc.encode(c.x as f32);
-                out[3 * px + 1] = enc.encode(c.y as f32);
-                out[3 * px + 2] = enc.encode(c.z as f32);
-            }
+            encode_slice(&acc, out);
         }
     }
 }
