@@ -43,6 +43,10 @@ impl ParamSpec {
             Value::Scalar(x) => vec![x],
             Value::Vector(v) => (if self.hsv { rgb_to_hsv(v) } else { v }).to_vec(),
         };
+        let mut x = x;
+        if self.hsv && self.min[0] < 0.0 && x[0] < self.min[0] + 1.0 {
+            x[0] = x[0].rem_euclid(1.0); // the circle's point inside the search interval
+        }
         (0..self.dim())
             .map(|c| {
                 let span = self.max[c] - self.min[c];
@@ -75,12 +79,21 @@ impl ParamSpace {
                     Bound::Scalar(x) => vec![x; n],
                     Bound::Vector(v) => v[..n].to_vec(),
                 };
+                let hsv = f.space == ColorSpace::Hsv;
+                let (mut min, mut max) = (expand(f.min), expand(f.max));
+                if hsv && min[0] <= 0.0 && max[0] >= 1.0 {
+                    // Hue is a circle: search it over an interval that
+                    // overlaps itself, so that no hue sits on a bound (a red
+                    // at hue 0.002 was otherwise pinned to the bound at 0).
+                    min[0] = -0.25;
+                    max[0] = 1.25;
+                }
                 Some(ParamSpec {
                     name: f.param.clone(),
                     field,
-                    min: expand(f.min),
-                    max: expand(f.max),
-                    hsv: f.space == ColorSpace::Hsv,
+                    min,
+                    max,
+                    hsv,
                     phase: f.phase.unwrap_or(1),
                 })
             })

@@ -1,0 +1,221 @@
+//! The physically based backends against the built-in tracer and on their
+//! own: a diffuse-only scene renders the same everywhere (within 0.5 %),
+//! `scenefit fit --renderer R` recovers a target R rendered, and missing
+//! renderers or unsupported fields are a user's error (exit code 2).
+//! Renderers run for real; a missing one skips its test unless CI=true.
+
+#[path = "backends_common/mod.rs"]
+mod common;
+
+use common::*;
+use scenefit::metric::deviation;
+use scenefit::render::{from_spec, render_one};
+use scenefit::scene::{parse, Scene};
+
+fn scene(v: &serde_json::Value) -> Scene {
+    parse(&v.to_string(), "test scene", &[]).expect("test scene is valid")
+}
+
+/// Renders the diffuse scene with `renderer` and compares it with the
+/// built-in tracer (4x4 supersampling: edges area-averaged like the others'
+/// box filter).
+fn agreement(renderer: &str) -> f64 {
+    let phong = render_one(
+        from_spec("phong").unwrap().as_ref(),
+        &scene(&diffuse_scene(64, 4)),
+        0,
+    )
+    .expect("phong renders");
+    let other = render_one(
+        from_spec(renderer).unwrap().as_ref(),
+        &scene(&diffuse_scene(64, 4)),
+        7,
+    )
+    .unwrap_or_else(|e| panic!("{renderer}: {e}"));
+    let d = deviation(&phong, &other, None);
+    eprintln!(
+        "{renderer} vs phong: deviation r {:.3} g {:.3} b {:.3} average {:.3} %",
+        d.r, d.g, d.b, d.average
+    );
+    d.average
+}
+
+#[test]
+fn povray_agrees_with_phong() {
+    if have("povray", "POV-Ray") {
+        assert!(agreement("povray") <= 0.5);
+    }
+}
+
+#[test]
+fn blender_agrees_with_phong() {
+    if have("blender", "Blender") {
+        assert!(agreement("blender") <= 0.5);
+    }
+}
+
+#[test]
+fn mitsuba_agrees_with_phong() {
+    if have_mitsuba() {
+        assert!(agreement("mitsuba") <= 0.5);
+    }
+}
+
+/// `scenefit fit --renderer R` on a target R rendered from the same scene
+/// (light intensity 10, floor diffuse 0.6), two free parameters, a small
+/// budget: the fit must come within 1.5 % average deviation.
+fn fit_recovers(renderer: &str) {
+    let dir = tempdir();
+    let d = dir.path();
+    write_json(d, "truth.json", &diffuse_scene(16, 2));
+    let mut start = with_free(diffuse_scene(16, 2));
+    start["lights"][0]["intensity"] = 15.0.into();
+    start["objects"][1]["material"]["diffuse"] = 0.9.into();
+    write_json(d, "scene.json", &start);
+    let o = run(
+        d,
+        &[
+            "render",
+            "truth.json",
+            "-o",
+            "target.png",
+            "--renderer",
+            renderer,
+            "--seed",
+            "3",
+        ],
+        &[],
+    );
+    expect_code(&o, 0);
+    let o = run(
+        d,
+        &[
+            "fit",
+            "scene.json",
+            "--target",
+            "target.png",
+            "-o",
+            "run",
+            "--renderer",
+            renderer,
+            "--population",
+            "8",
+            "--generations",
+            "8",
+            "--seed",
+            "1",
+            "-q",
+        ],
+        &[],
+    );
+    expect_code(&o, 0);
+    let r = result(&d.join("run"));
+    let dev = r["deviation"]["average"].as_f64().expect("deviation");
+    eprintln!(
+        "{renderer}: fit deviation {dev:.3} %, params {}, {} renders in {:.1} s",
+        r["params"],
+        r["evaluations"],
+        r["wall_seconds"].as_f64().unwrap_or(0.0)
+    );
+    assert_eq!(r["renderer"], renderer);
+    assert!(dev <= 1.5, "{renderer}: deviation {dev} % > 1.5 %");
+}
+
+#[test]
+fn povray_fit_recovers_its_own_target() {
+    if have("povray", "POV-Ray") {
+        fit_recovers("povray");
+    }
+}
+
+#[test]
+fn blender_fit_recovers_its_own_target() {
+    if have("blender", "Blender") {
+        fit_recovers("blender");
+    }
+}
+
+#[test]
+fn mitsuba_fit_recovers_its_own_target() {
+    if have_mitsuba() {
+        fit_recovers("mitsuba");
+    }
+}
+
+#[test]
+fn missing_renderer_says_how_to_install_it() {
+    let dir = tempdir();
+    let d = dir.path();
+    write_json(d, "scene.json", &diffuse_scene(16, 1));
+    // an empty PATH: no renderer can be found
+    let empty = tempdir();
+    let path = empty.path().to_str().expect("utf-8 temp path");
+    for (renderer, expected) in [
+        ("povray", "povray not found on PATH; install it with `apt-get install povray` or run scripts/install-renderers.sh"),
+        ("blender", "blender not found on PATH; install it with `apt-get install blender`"),
+        ("mitsuba", "python3 not found on PATH"),
+    ] {
+        let o = run(d, &["render", "scene.json", "-o", "out.png", "--renderer", renderer], &[("PATH", path)]);
+        expect_code(&o, 2);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(err.contains(expected), "{renderer}: {err}");
+    }
+    let o = run(
+        d,
+        &[
+            "render",
+            "scene.json",
+            "-o",
+            "out.png",
+            "--renderer",
+            "mitsuba",
+        ],
+        &[("SCENEFIT_PYTHON", "/nonexistent/python3")],
+    );
+    expect_code(&o, 2);
+    assert!(String::from_utf8_lossy(&o.stderr).contains("SCENEFIT_PYTHON"));
+}
+
+#[test]
+fn mitsuba_refuses_falloff_none() {
+    let dir = tempdir();
+    let d = dir.path();
+    let mut s = diffuse_scene(16, 1);
+    s["lights"][0]["falloff"] = "none".into();
+    write_json(d, "scene.json", &s);
+    let o = run(
+        d,
+        &[
+            "render",
+            "scene.json",
+            "-o",
+            "out.png",
+            "--renderer",
+            "mitsuba",
+        ],
+        &[],
+    );
+    expect_code(&o, 2);
+    assert!(String::from_utf8_lossy(&o.stderr).contains("falloff \"none\" is not supported"));
+}
+
+#[test]
+fn bad_timeout_setting_is_a_usage_error() {
+    let dir = tempdir();
+    let d = dir.path();
+    write_json(d, "scene.json", &diffuse_scene(16, 1));
+    let o = run(
+        d,
+        &[
+            "render",
+            "scene.json",
+            "-o",
+            "out.png",
+            "--renderer",
+            "cmd:true",
+        ],
+        &[("SCENEFIT_RENDER_TIMEOUT", "soon")],
+    );
+    expect_code(&o, 2);
+    assert!(String::from_utf8_lossy(&o.stderr).contains("SCENEFIT_RENDER_TIMEOUT=soon"));
+}
