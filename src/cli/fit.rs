@@ -121,6 +121,9 @@ pub fn run(a: FitArgs) -> Result<()> {
         .transpose()?;
     let renderer = from_spec(&a.renderer)?;
     let mut config = a.search.config()?;
+    if a.search.jobs.is_none() {
+        config.jobs = renderer.default_jobs();
+    }
     config.resume = a.resume;
     config.interrupt = Some(interrupt_flag());
     let target = FitTarget {

@@ -13,7 +13,6 @@ use std::collections::VecDeque;
 use std::future::Future;
 use std::path::PathBuf;
 use std::sync::{Arc, Mutex};
-use std::time::Duration;
 use tokio::runtime::Runtime;
 use tokio::task::JoinSet;
 
@@ -86,14 +85,22 @@ pub fn combine(mut failures: Vec<RenderFailure>) -> RenderFailure {
             stderr: String::new(),
         };
     };
-    if !failures.is_empty() {
-        let earlier: Vec<String> = failures.iter().map(|f| f.message.clone()).collect();
-        last.message = format!(
-            "{} (after {} attempts; earlier: {})",
-            last.message,
-            failures.len() + 1,
-            earlier.join("; ")
-        );
+    let attempts = failures.len() + 1;
+    if attempts > 1 {
+        let other: Vec<&str> = failures
+            .iter()
+            .map(|f| f.message.as_str())
+            .filter(|m| *m != last.message)
+            .collect();
+        last.message = if other.is_empty() {
+            format!("{} ({attempts} attempts, each the same)", last.message)
+        } else {
+            format!(
+                "{} ({attempts} attempts; before: {})",
+                last.message,
+                other.join("; ")
+            )
+        };
     }
     last
 }
@@ -255,7 +262,7 @@ impl Slot {
                         Ok(img) => return Ok(img),
                         Err(m) => failures.push(RenderFailure {
                             message: format!("the worker answered ok but {m}"),
-                            stderr: settled_tail(w).await,
+                            stderr: w.output().await,
                         }),
                     }
                 }
@@ -263,7 +270,7 @@ impl Slot {
                     output::remove(&job.output);
                     failures.push(RenderFailure {
                         message: format!("the worker failed: {m}"),
-                        stderr: settled_tail(w).await,
+                        stderr: w.output().await,
                     });
                 }
                 Err(RequestError::Dead(m)) => {
@@ -278,10 +285,4 @@ impl Slot {
         }
         Err(combine(failures))
     }
-}
-
-/// The worker's output once the lines it printed with its answer are in.
-async fn settled_tail(w: &Worker) -> String {
-    tokio::time::sleep(Duration::from_millis(20)).await;
-    w.tail.text()
 }

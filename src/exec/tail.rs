@@ -13,7 +13,14 @@ pub const TAIL_BYTES: usize = 4096;
 /// A bounded buffer of the most recent output.
 #[derive(Debug, Default)]
 pub struct Tail {
-    buf: Mutex<VecDeque<u8>>,
+    buf: Mutex<Buf>,
+}
+
+#[derive(Debug, Default)]
+struct Buf {
+    bytes: VecDeque<u8>,
+    /// Bytes ever pushed: marks say where a request's output starts.
+    total: u64,
 }
 
 impl Tail {
@@ -24,10 +31,16 @@ impl Tail {
     /// Appends bytes, dropping the oldest beyond `TAIL_BYTES`.
     pub fn push(&self, bytes: &[u8]) {
         let mut b = self.buf.lock().unwrap_or_else(|p| p.into_inner());
+        b.total += bytes.len() as u64;
         let bytes = &bytes[bytes.len().saturating_sub(TAIL_BYTES)..];
-        let excess = (b.len() + bytes.len()).saturating_sub(TAIL_BYTES);
-        b.drain(..excess);
-        b.extend(bytes);
+        let excess = (b.bytes.len() + bytes.len()).saturating_sub(TAIL_BYTES);
+        b.bytes.drain(..excess);
+        b.bytes.extend(bytes);
+    }
+
+    /// Where the output printed from now on starts (see `text_since`).
+    pub fn mark(&self) -> u64 {
+        self.buf.lock().unwrap_or_else(|p| p.into_inner()).total
     }
 
     /// Appends one line with a prefix that says where it came from.
@@ -37,13 +50,18 @@ impl Tail {
 
     /// The kept text (lossy UTF-8; a cut-off first line is dropped).
     pub fn text(&self) -> String {
+        self.text_since(0)
+    }
+
+    /// What was printed after `mark` (as much of it as is kept).
+    pub fn text_since(&self, mark: u64) -> String {
         let b = self.buf.lock().unwrap_or_else(|p| p.into_inner());
-        let (a, c) = b.as_slices();
-        let mut v = Vec::with_capacity(b.len());
-        v.extend_from_slice(a);
-        v.extend_from_slice(c);
+        let new = usize::try_from(b.total.saturating_sub(mark)).unwrap_or(usize::MAX);
+        let skip = b.bytes.len().saturating_sub(new);
+        let v: Vec<u8> = b.bytes.iter().skip(skip).copied().collect();
         let s = String::from_utf8_lossy(&v).into_owned();
-        if b.len() >= TAIL_BYTES {
+        // part of the range was dropped: its first line is cut off
+        if new > b.bytes.len() {
             if let Some(i) = s.find('\n') {
                 return s[i + 1..].to_string();
             }
@@ -86,5 +104,9 @@ mod tests {
         let t = Tail::new();
         t.push(b"short");
         assert_eq!(t.text(), "short");
+        let m = t.mark();
+        t.push(b" and more");
+        assert_eq!(t.text_since(m), " and more");
+        assert_eq!(t.text_since(t.mark()), "");
     }
 }

@@ -26,6 +26,8 @@ pub struct Worker {
     pub renderer: String,
     /// Requests answered so far.
     pub renders: usize,
+    /// Where the current request's output starts in `tail`.
+    mark: u64,
 }
 
 /// Why a request did not succeed.
@@ -85,6 +87,7 @@ impl Worker {
             tail,
             renderer: String::new(),
             renders: 0,
+            mark: 0,
         };
         let deadline = Instant::now() + timeout;
         loop {
@@ -228,12 +231,18 @@ impl Worker {
         }
     }
 
-    /// Kills the worker (and its process group) and returns what it printed.
+    /// What the worker printed since the current request was sent (all of
+    /// it before the first request), once its last lines are in.
+    pub async fn output(&self) -> String {
+        // the stderr drain runs on its own task: give it a moment
+        tokio::time::sleep(Duration::from_millis(20)).await;
+        self.tail.text_since(self.mark)
+    }
+
+    /// Kills the worker (and its process group) and returns `output()`.
     pub async fn stop(mut self) -> String {
         kill_group(&mut self.child, self.pid);
         let _ = tokio::time::timeout(Duration::from_secs(5), self.child.wait()).await;
-        // give the stderr drain a moment to collect the last lines
-        tokio::time::sleep(Duration::from_millis(20)).await;
-        self.tail.text()
+        self.output().await
     }
 }
