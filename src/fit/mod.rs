@@ -238,6 +238,10 @@ pub fn run(
                 .as_ref()
                 .map(|img| deviation(&target.image, img, target.mask.as_ref()))
                 .unwrap_or_default();
+            // Checkpoint first: a run killed in between then redoes no
+            // generation and writes no progress line twice.
+            state.elapsed_before += generation_started.elapsed().as_secs_f64();
+            state.save(dir)?;
             if global_gen % config.snapshot_every.max(1) == 0 {
                 if let Some(img) = &best_image {
                     output::snapshot(dir, global_gen, img)?;
@@ -249,15 +253,13 @@ pub fn run(
                     &space.json_values(&best_scene),
                 )?;
             }
-            state.elapsed_before += generation_started.elapsed().as_secs_f64();
-            state.save(dir)?;
             observer.generation(&GenerationReport {
                 generation: global_gen,
                 total_generations: budgets.iter().sum(),
                 evaluations,
                 best: best_dev,
-                renders_per_second: candidates.len() as f64
-                    / generation_started.elapsed().as_secs_f64().max(1e-9),
+                // Averaged over the run: one generation's rate jumps about.
+                renders_per_second: evaluations as f64 / state.elapsed_before.max(1e-9),
                 elapsed: state.elapsed_before,
                 phase,
                 failures: &failures,
