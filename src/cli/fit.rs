@@ -53,7 +53,7 @@ impl SearchArgs {
             return Err(Error::Usage("--jobs: expected 1 or more".into()));
         }
         if let Some(d) = self.target_deviation {
-            if !(d >= 0.0) {
+            if d.is_nan() || d < 0.0 {
                 return Err(Error::Usage(format!(
                     "--target-deviation: expected a percentage >= 0, got {d}"
                 )));

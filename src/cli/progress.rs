@@ -49,7 +49,7 @@ impl Observer for Progress {
                 b.set_position(r.generation as u64);
                 b.set_message(msg);
             }
-            None if r.generation % 10 == 0 => eprintln!(
+            None if r.generation.is_multiple_of(10) => eprintln!(
                 "generation {} of {}: {msg}, {} renders, {:.1} s",
                 r.generation, r.total_generations, r.evaluations, r.elapsed
             ),
