@@ -150,6 +150,7 @@ impl Worker {
         id: u64,
         timeout: Duration,
     ) -> Result<(), RequestError> {
+        self.mark = self.tail.mark();
         let deadline = Instant::now() + timeout;
         let sent = tokio::time::timeout_at(deadline, async {
             self.stdin.write_all(line.as_bytes()).await?;
