@@ -23,7 +23,10 @@ fn have_python() -> bool {
 }
 
 fn lambert() -> String {
-    root().join("examples/plugins/lambert.py").display().to_string()
+    root()
+        .join("examples/plugins/lambert.py")
+        .display()
+        .to_string()
 }
 
 fn faulty() -> String {
@@ -50,12 +53,43 @@ fn plugin_fits(renderer: &str) {
     start["lights"][0]["intensity"] = 15.0.into();
     start["free"] = serde_json::json!([{"param": "lights.key.intensity", "min": 4, "max": 20}]);
     write_json(d, "scene.json", &start);
-    let o = run(d, &["render", "truth.json", "-o", "target.png", "--renderer", renderer], &[]);
+    let o = run(
+        d,
+        &[
+            "render",
+            "truth.json",
+            "-o",
+            "target.png",
+            "--renderer",
+            renderer,
+        ],
+        &[],
+    );
     expect_code(&o, 0);
-    let o = run(d, &["fit", "scene.json", "--target", "target.png", "-o", "run", "--renderer", renderer, "--population", "8", "--generations", "10", "-q"], &[]);
+    let o = run(
+        d,
+        &[
+            "fit",
+            "scene.json",
+            "--target",
+            "target.png",
+            "-o",
+            "run",
+            "--renderer",
+            renderer,
+            "--population",
+            "8",
+            "--generations",
+            "10",
+            "-q",
+        ],
+        &[],
+    );
     expect_code(&o, 0);
     let r = result(&d.join("run"));
-    let intensity = r["params"]["lights.key.intensity"].as_f64().expect("fitted intensity");
+    let intensity = r["params"]["lights.key.intensity"]
+        .as_f64()
+        .expect("fitted intensity");
     let dev = r["deviation"]["average"].as_f64().expect("deviation");
     eprintln!("{renderer}: intensity {intensity:.3} (truth 10), deviation {dev:.3} %");
     assert!((intensity - 10.0).abs() < 0.3, "intensity {intensity}");
@@ -89,7 +123,9 @@ fn render_mix(renderer: &str, n: usize, jobs: usize) -> Vec<RenderResult> {
         })
         .collect();
     let r = from_spec(renderer).expect("renderer spec");
-    let mut session = r.session(&base, &ParamSpace::default(), jobs).expect("session starts");
+    let mut session = r
+        .session(&base, &ParamSpace::default(), jobs)
+        .expect("session starts");
     session.render_batch(&scenes, 1)
 }
 
@@ -108,19 +144,46 @@ fn one_shot_faults_fail_their_render_only() {
     let _env = ENV.lock().unwrap_or_else(|p| p.into_inner());
     std::env::set_var("SCENEFIT_RENDER_TIMEOUT", "1.5");
     let started = std::time::Instant::now();
-    let r = render_mix(&format!("cmd:python3 {} --fault mixed {{scene}} {{output}}", faulty()), 8, 8);
+    let r = render_mix(
+        &format!(
+            "cmd:python3 {} --fault mixed {{scene}} {{output}}",
+            faulty()
+        ),
+        8,
+        8,
+    );
     std::env::remove_var("SCENEFIT_RENDER_TIMEOUT");
     // ok, crash, ok, noimage, garbage, ok, wrongsize, hang
     for i in [0, 2, 5] {
         assert!(r[i].is_ok(), "render {i}: {}", failure(&r[i]));
     }
     let crash = failure(&r[1]);
-    assert!(crash.contains("exited with status 3") && crash.contains("crashing on purpose") && crash.contains("2 attempts"), "{crash}");
-    assert!(failure(&r[3]).contains("exited 0 but no image was written"), "{}", failure(&r[3]));
-    assert!(failure(&r[4]).contains("is not an image"), "{}", failure(&r[4]));
-    assert!(failure(&r[6]).contains("is 8x6, expected 64x48"), "{}", failure(&r[6]));
+    assert!(
+        crash.contains("exited with status 3")
+            && crash.contains("crashing on purpose")
+            && crash.contains("2 attempts"),
+        "{crash}"
+    );
+    assert!(
+        failure(&r[3]).contains("exited 0 but no image was written"),
+        "{}",
+        failure(&r[3])
+    );
+    assert!(
+        failure(&r[4]).contains("is not an image"),
+        "{}",
+        failure(&r[4])
+    );
+    assert!(
+        failure(&r[6]).contains("is 8x6, expected 64x48"),
+        "{}",
+        failure(&r[6])
+    );
     let hang = failure(&r[7]);
-    assert!(hang.contains("timed out after 1.5 s") && hang.contains("hanging on purpose"), "{hang}");
+    assert!(
+        hang.contains("timed out after 1.5 s") && hang.contains("hanging on purpose"),
+        "{hang}"
+    );
     // two attempts of 1.5 s for the hang, the rest in parallel
     assert!(started.elapsed().as_secs_f64() < 20.0);
 }
@@ -132,22 +195,42 @@ fn worker_faults_fail_their_render_only() {
     }
     let _env = ENV.lock().unwrap_or_else(|p| p.into_inner());
     std::env::set_var("SCENEFIT_RENDER_TIMEOUT", "1.5");
-    let r = render_mix(&format!("worker:python3 {} --worker --fault mixed", faulty()), 10, 2);
+    let r = render_mix(
+        &format!("worker:python3 {} --worker --fault mixed", faulty()),
+        10,
+        2,
+    );
     std::env::remove_var("SCENEFIT_RENDER_TIMEOUT");
     // ok, crash, ok, noimage, garbage, refuse, wrongsize, noise, hang, ok
     for i in [0, 2, 7, 9] {
         assert!(r[i].is_ok(), "render {i}: {}", failure(&r[i]));
     }
     let crash = failure(&r[1]);
-    assert!(crash.contains("the worker exited with status 3 while rendering") && crash.contains("crashing on purpose"), "{crash}");
+    assert!(
+        crash.contains("the worker exited with status 3 while rendering")
+            && crash.contains("crashing on purpose"),
+        "{crash}"
+    );
     assert!(crash.contains("2 attempts"), "{crash}");
-    assert!(failure(&r[3]).contains("the worker answered ok but no image was written"), "{}", failure(&r[3]));
+    assert!(
+        failure(&r[3]).contains("the worker answered ok but no image was written"),
+        "{}",
+        failure(&r[3])
+    );
     assert!(failure(&r[4]).contains("is not an image"));
     let refused = failure(&r[5]);
-    assert!(refused.contains("the worker failed: refused on purpose") && refused.contains("refusing on purpose"), "{refused}");
+    assert!(
+        refused.contains("the worker failed: refused on purpose")
+            && refused.contains("refusing on purpose"),
+        "{refused}"
+    );
     assert!(failure(&r[6]).contains("is 8x6, expected 64x48"));
     let hang = failure(&r[8]);
-    assert!(hang.contains("timed out after 1.5 s and was killed") && hang.contains("hanging on purpose"), "{hang}");
+    assert!(
+        hang.contains("timed out after 1.5 s and was killed")
+            && hang.contains("hanging on purpose"),
+        "{hang}"
+    );
 }
 
 #[test]
@@ -155,7 +238,14 @@ fn worker_that_dies_is_replaced_and_its_request_retried() {
     if !have_python() {
         return;
     }
-    let r = render_mix(&format!("worker:python3 {} --worker --fault dieafter --after 2", faulty()), 7, 1);
+    let r = render_mix(
+        &format!(
+            "worker:python3 {} --worker --fault dieafter --after 2",
+            faulty()
+        ),
+        7,
+        1,
+    );
     for (i, x) in r.iter().enumerate() {
         assert!(x.is_ok(), "render {i}: {}", failure(x));
     }
@@ -167,7 +257,10 @@ fn worker_is_restarted_after_max_renders() {
         return;
     }
     let _env = ENV.lock().unwrap_or_else(|p| p.into_inner());
-    let spec = format!("worker:python3 {} --worker --fault limit --after 3", faulty());
+    let spec = format!(
+        "worker:python3 {} --worker --fault limit --after 3",
+        faulty()
+    );
     std::env::set_var("SCENEFIT_WORKER_MAX_RENDERS", "3");
     let r = render_mix(&spec, 8, 1);
     std::env::remove_var("SCENEFIT_WORKER_MAX_RENDERS");
@@ -186,12 +279,21 @@ fn worker_that_cannot_start_is_a_clear_error() {
         return;
     }
     let base = scene(&small_scene());
-    let r = from_spec(&format!("worker:python3 {} --worker --fault nostart", faulty())).unwrap();
+    let r = from_spec(&format!(
+        "worker:python3 {} --worker --fault nostart",
+        faulty()
+    ))
+    .unwrap();
     let err = match r.session(&base, &ParamSpace::default(), 2) {
         Ok(_) => panic!("the session started"),
         Err(e) => e.to_string(),
     };
-    assert!(err.contains("no worker started") && err.contains("exited before it was ready (exited with status 4)") && err.contains("refusing to start"), "{err}");
+    assert!(
+        err.contains("no worker started")
+            && err.contains("exited before it was ready (exited with status 4)")
+            && err.contains("refusing to start"),
+        "{err}"
+    );
 }
 
 #[test]
@@ -205,10 +307,39 @@ fn fit_survives_failing_renders_and_logs_them() {
     write_json(d, "truth.json", &s);
     s["free"] = serde_json::json!([{"param": "lights.key.intensity", "min": 4, "max": 20}]);
     write_json(d, "scene.json", &s);
-    let o = run(d, &["render", "truth.json", "-o", "target.png", "--renderer", &format!("cmd:python3 {}", lambert())], &[]);
+    let o = run(
+        d,
+        &[
+            "render",
+            "truth.json",
+            "-o",
+            "target.png",
+            "--renderer",
+            &format!("cmd:python3 {}", lambert()),
+        ],
+        &[],
+    );
     expect_code(&o, 0);
     let renderer = format!("worker:python3 {} --worker --fault mixed", faulty());
-    let o = run(d, &["fit", "scene.json", "--target", "target.png", "-o", "run", "--renderer", &renderer, "--population", "10", "--generations", "3", "-q"], &[("SCENEFIT_RENDER_TIMEOUT", "1")]);
+    let o = run(
+        d,
+        &[
+            "fit",
+            "scene.json",
+            "--target",
+            "target.png",
+            "-o",
+            "run",
+            "--renderer",
+            &renderer,
+            "--population",
+            "10",
+            "--generations",
+            "3",
+            "-q",
+        ],
+        &[("SCENEFIT_RENDER_TIMEOUT", "1")],
+    );
     expect_code(&o, 0);
     let r = result(&d.join("run"));
     let failed = r["failed_renders"].as_u64().expect("failed_renders");
@@ -230,14 +361,44 @@ fn generation_that_fails_entirely_stops_the_run_and_resume_continues() {
     s["free"] = serde_json::json!([{"param": "lights.key.intensity", "min": 4, "max": 20}]);
     write_json(d, "scene.json", &s);
     let renderer = format!("cmd:python3 {} --fault ok {{scene}} {{output}}", faulty());
-    let o = run(d, &["render", "truth.json", "-o", "target.png", "--renderer", &renderer], &[]);
+    let o = run(
+        d,
+        &[
+            "render",
+            "truth.json",
+            "-o",
+            "target.png",
+            "--renderer",
+            &renderer,
+        ],
+        &[],
+    );
     expect_code(&o, 0);
-    let fit = ["fit", "scene.json", "--target", "target.png", "-o", "run", "--renderer", &renderer, "--population", "6", "--generations", "6", "-q"];
+    let fit = [
+        "fit",
+        "scene.json",
+        "--target",
+        "target.png",
+        "-o",
+        "run",
+        "--renderer",
+        &renderer,
+        "--population",
+        "6",
+        "--generations",
+        "6",
+        "-q",
+    ];
     // the renderer breaks: every render of the first generation fails
     let o = run(d, &fit, &[("FAULTY_MODE", "crash")]);
     expect_code(&o, 1);
     let err = String::from_utf8_lossy(&o.stderr);
-    assert!(err.contains("every render of generation") && err.contains("--resume") && err.contains("crashing on purpose"), "{err}");
+    assert!(
+        err.contains("every render of generation")
+            && err.contains("--resume")
+            && err.contains("crashing on purpose"),
+        "{err}"
+    );
     assert!(d.join("run/checkpoint.json").is_file());
     // repaired, the run continues from its checkpoint
     let mut resume = fit.to_vec();
@@ -246,6 +407,8 @@ fn generation_that_fails_entirely_stops_the_run_and_resume_continues() {
     expect_code(&o, 0);
     let r = result(&d.join("run"));
     assert_eq!(r["generations"], 6);
-    let intensity = r["params"]["lights.key.intensity"].as_f64().expect("intensity");
+    let intensity = r["params"]["lights.key.intensity"]
+        .as_f64()
+        .expect("intensity");
     assert!((intensity - 10.0).abs() < 1.0, "{intensity}");
 }
