@@ -176,18 +176,18 @@ fn parameter_errors(
                         (
                             d,
                             format!(
-                                "{:.2} mm = {:.2} % of its distance to the sphere",
+                                "{:.3} mm = {:.3} % of its distance to the sphere",
                                 d * 1000.0,
                                 100.0 * d / dist
                             ),
                         )
                     } else {
-                        (max, format!("largest component off by {max:.4}"))
+                        (max, format!("largest component off by {max:.5}"))
                     }
                 }
                 (Some(Value::Scalar(t)), Some(Value::Scalar(f))) => (
                     (t - f).abs(),
-                    format!("{f:.4} for {t:.4} ({:+.2} %)", 100.0 * (f - t) / t),
+                    format!("{f:.5} for {t:.5} ({:+.3} %)", 100.0 * (f - t) / t),
                 ),
                 _ => (f64::NAN, "?".into()),
             };
