@@ -3,6 +3,7 @@
 //! `cmd:TEMPLATE`, `worker:COMMAND`). Nothing outside this module knows
 //! which backend runs.
 
+pub mod camera_effects;
 pub mod image_io;
 pub mod phong;
 pub mod srgb;
@@ -73,8 +74,14 @@ pub trait RenderSession: Send {
     fn render_batch(&mut self, scenes: &[Scene], seed: u64) -> Vec<RenderResult>;
 }
 
-/// The backend named by `spec` (see the module doc).
+/// The backend named by `spec` (see the module doc), followed by the
+/// camera's image-space effects (`camera_effects.rs`).
 pub fn from_spec(spec: &str) -> Result<Box<dyn Renderer>> {
+    Ok(Box::new(camera_effects::WithCameraEffects(backend(spec)?)))
+}
+
+/// The bare backend named by `spec`.
+fn backend(spec: &str) -> Result<Box<dyn Renderer>> {
     match spec {
         "phong" => Ok(Box::new(phong::Phong)),
         "povray" => Ok(Box::new(povray::PovRay)),

@@ -2,6 +2,11 @@
 //! `objects.ball.material.color`, `camera.fov_y_deg`, `ambient`. A path is
 //! resolved once against a scene into a `Field`, which then reads and writes
 //! that value in any copy of the scene without string matching.
+//!
+//! The optional effect fields (`indirect_light`, `lights.NAME.falloff_power`,
+//! `objects.NAME.material.fresnel|specular2|shininess2`,
+//! `camera.vignetting.strength`, `camera.response.gain|gamma|black`) resolve
+//! only when the scene has them: set them first, then free them.
 
 use super::types::{Scene, Vec3};
 
@@ -9,6 +14,7 @@ use super::types::{Scene, Vec3};
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Field {
     Ambient,
+    IndirectLight,
     Light(usize, LightField),
     Material(usize, MaterialField),
     Shape(usize, ShapeField),
@@ -22,6 +28,7 @@ pub enum LightField {
     Color,
     Intensity,
     Radius,
+    FalloffPower,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -33,6 +40,9 @@ pub enum MaterialField {
     Reflection,
     Transmission,
     Ior,
+    Fresnel,
+    Specular2,
+    Shininess2,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -55,6 +65,10 @@ pub enum CameraField {
     Up,
     FovY,
     Height,
+    Vignetting,
+    ResponseGain,
+    ResponseGamma,
+    ResponseBlack,
 }
 
 /// A field's value: a number or a 3-vector.
@@ -85,6 +99,7 @@ impl Field {
         let parts: Vec<&str> = path.split('.').collect();
         match parts.as_slice() {
             ["ambient"] => Ok(Field::Ambient),
+            ["indirect_light"] => present(scene, Field::IndirectLight, path),
             ["lights", name, field] => {
                 let i = scene
                     .light_index(name)
@@ -95,8 +110,12 @@ impl Field {
                     "color" => LightField::Color,
                     "intensity" => LightField::Intensity,
                     "radius" => LightField::Radius,
-                    other => return Err(format!("a light has no numeric field \"{other}\" (expected position, direction, color, intensity or radius)")),
+                    "falloff_power" => LightField::FalloffPower,
+                    other => return Err(format!("a light has no numeric field \"{other}\" (expected position, direction, color, intensity, radius or falloff_power)")),
                 };
+                if f == LightField::FalloffPower {
+                    return present(scene, Field::Light(i, f), path);
+                }
                 Ok(Field::Light(i, f))
             }
             ["objects", name, "material", field] => {
@@ -109,8 +128,14 @@ impl Field {
                     "reflection" => MaterialField::Reflection,
                     "transmission" => MaterialField::Transmission,
                     "ior" => MaterialField::Ior,
-                    other => return Err(format!("a material has no field \"{other}\" (expected color, diffuse, specular, shininess, reflection, transmission or ior)")),
+                    "fresnel" => MaterialField::Fresnel,
+                    "specular2" => MaterialField::Specular2,
+                    "shininess2" => MaterialField::Shininess2,
+                    other => return Err(format!("a material has no field \"{other}\" (expected color, diffuse, specular, shininess, reflection, transmission, ior, fresnel, specular2 or shininess2)")),
                 };
+                if matches!(f, MaterialField::Fresnel | MaterialField::Specular2 | MaterialField::Shininess2) {
+                    return present(scene, Field::Material(i, f), path);
+                }
                 Ok(Field::Material(i, f))
             }
             ["objects", name, "shape", field] => {
@@ -148,7 +173,17 @@ impl Field {
                 }
                 Ok(field)
             }
-            _ => Err("expected ambient, lights.NAME.FIELD, objects.NAME.material.FIELD, objects.NAME.shape.FIELD or camera.FIELD".into()),
+            ["camera", group, field] => {
+                let f = match (*group, *field) {
+                    ("vignetting", "strength") => CameraField::Vignetting,
+                    ("response", "gain") => CameraField::ResponseGain,
+                    ("response", "gamma") => CameraField::ResponseGamma,
+                    ("response", "black") => CameraField::ResponseBlack,
+                    _ => return Err("expected camera.vignetting.strength or camera.response.gain|gamma|black".into()),
+                };
+                present(scene, Field::Camera(f), path)
+            }
+            _ => Err("expected ambient, indirect_light, lights.NAME.FIELD, objects.NAME.material.FIELD, objects.NAME.shape.FIELD or camera.FIELD".into()),
         }
     }
 
@@ -158,6 +193,7 @@ impl Field {
         use Value::{Scalar, Vector};
         Some(match *self {
             Field::Ambient => Vector(scene.ambient),
+            Field::IndirectLight => Scalar(scene.indirect_light?),
             Field::Light(i, f) => {
                 let l = &scene.lights[i];
                 match f {
@@ -166,6 +202,7 @@ impl Field {
                     LightField::Color => Vector(l.color),
                     LightField::Intensity => Scalar(l.intensity),
                     LightField::Radius => Scalar(l.radius),
+                    LightField::FalloffPower => Scalar(l.falloff_power?),
                 }
             }
             Field::Material(i, f) => {
@@ -178,6 +215,9 @@ impl Field {
                     MaterialField::Reflection => Scalar(m.reflection),
                     MaterialField::Transmission => Scalar(m.transmission),
                     MaterialField::Ior => Scalar(m.ior),
+                    MaterialField::Fresnel => Scalar(m.fresnel?),
+                    MaterialField::Specular2 => Scalar(m.specular2?),
+                    MaterialField::Shininess2 => Scalar(m.shininess2?),
                 }
             }
             Field::Shape(i, f) => {
@@ -202,6 +242,10 @@ impl Field {
                     CameraField::Up => Vector(c.up),
                     CameraField::FovY => Scalar(c.fov_y_deg?),
                     CameraField::Height => Scalar(c.height?),
+                    CameraField::Vignetting => Scalar(c.vignetting?.strength),
+                    CameraField::ResponseGain => Scalar(c.response?.gain),
+                    CameraField::ResponseGamma => Scalar(c.response?.gamma),
+                    CameraField::ResponseBlack => Scalar(c.response?.black),
                 }
             }
         })
@@ -232,6 +276,7 @@ impl Field {
         }
         match *self {
             Field::Ambient => v(&mut scene.ambient, value),
+            Field::IndirectLight => os(&mut scene.indirect_light, value),
             Field::Light(i, f) => {
                 let l = &mut scene.lights[i];
                 match f {
@@ -240,6 +285,7 @@ impl Field {
                     LightField::Color => v(&mut l.color, value),
                     LightField::Intensity => s(&mut l.intensity, value),
                     LightField::Radius => s(&mut l.radius, value),
+                    LightField::FalloffPower => os(&mut l.falloff_power, value),
                 }
             }
             Field::Material(i, f) => {
@@ -252,6 +298,9 @@ impl Field {
                     MaterialField::Reflection => s(&mut m.reflection, value),
                     MaterialField::Transmission => s(&mut m.transmission, value),
                     MaterialField::Ior => s(&mut m.ior, value),
+                    MaterialField::Fresnel => os(&mut m.fresnel, value),
+                    MaterialField::Specular2 => os(&mut m.specular2, value),
+                    MaterialField::Shininess2 => os(&mut m.shininess2, value),
                 }
             }
             Field::Shape(i, f) => {
@@ -276,6 +325,26 @@ impl Field {
                     CameraField::Up => v(&mut c.up, value),
                     CameraField::FovY => os(&mut c.fov_y_deg, value),
                     CameraField::Height => os(&mut c.height, value),
+                    CameraField::Vignetting => {
+                        if let Some(vg) = c.vignetting.as_mut() {
+                            s(&mut vg.strength, value)
+                        }
+                    }
+                    CameraField::ResponseGain => {
+                        if let Some(r) = c.response.as_mut() {
+                            s(&mut r.gain, value)
+                        }
+                    }
+                    CameraField::ResponseGamma => {
+                        if let Some(r) = c.response.as_mut() {
+                            s(&mut r.gamma, value)
+                        }
+                    }
+                    CameraField::ResponseBlack => {
+                        if let Some(r) = c.response.as_mut() {
+                            s(&mut r.black, value)
+                        }
+                    }
                 }
             }
         }
@@ -297,9 +366,41 @@ impl Field {
     pub fn moves_geometry(&self) -> bool {
         matches!(
             self,
-            Field::Camera(_) | Field::Shape(..) | Field::Material(_, MaterialField::Ior)
+            Field::Camera(
+                CameraField::Position
+                    | CameraField::LookAt
+                    | CameraField::Up
+                    | CameraField::FovY
+                    | CameraField::Height
+            ) | Field::Shape(..)
+                | Field::Material(_, MaterialField::Ior)
         )
     }
+
+    /// True for fields applied to the finished image (camera vignetting and
+    /// response), whatever renderer made it.
+    pub fn is_image_space(&self) -> bool {
+        matches!(
+            self,
+            Field::Camera(
+                CameraField::Vignetting
+                    | CameraField::ResponseGain
+                    | CameraField::ResponseGamma
+                    | CameraField::ResponseBlack
+            )
+        )
+    }
+}
+
+/// `field` when the scene has it; optional effect fields must be set before
+/// they can be freed.
+fn present(scene: &Scene, field: Field, path: &str) -> Result<Field, String> {
+    if field.get(scene).is_none() {
+        return Err(format!(
+            "the scene has no \"{path}\" (an optional field: give it a value first)"
+        ));
+    }
+    Ok(field)
 }
 
 fn object(scene: &Scene, name: &str) -> Result<usize, String> {

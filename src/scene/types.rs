@@ -21,6 +21,10 @@ pub struct Scene {
     pub render: RenderSettings,
     pub lights: Vec<Light>,
     pub objects: Vec<Object>,
+    /// Strength of the built-in tracer's one-bounce inter-reflection
+    /// (absent: none). See docs/scene-format.md "Effects".
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub indirect_light: Option<f64>,
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub free: Vec<FreeParam>,
 }
@@ -54,6 +58,42 @@ pub struct Camera {
     pub fov_y_deg: Option<f64>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub height: Option<f64>,
+    /// Image-space darkening towards the corners (absent: none).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub vignetting: Option<Vignetting>,
+    /// The camera's response curve on linear values (absent: identity).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub response: Option<Response>,
+}
+
+/// radiance x (1 - strength * r^2), r the distance from the image centre
+/// over the half-diagonal.
+#[derive(Clone, Copy, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct Vignetting {
+    pub strength: f64,
+}
+
+/// v -> black + gain * v^gamma on linear values, before sRGB encoding.
+#[derive(Clone, Copy, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct Response {
+    #[serde(default = "one")]
+    pub gain: f64,
+    #[serde(default = "one")]
+    pub gamma: f64,
+    #[serde(default)]
+    pub black: f64,
+}
+
+impl Default for Response {
+    fn default() -> Self {
+        Response {
+            gain: 1.0,
+            gamma: 1.0,
+            black: 0.0,
+        }
+    }
 }
 
 fn default_up() -> Vec3 {
@@ -135,6 +175,9 @@ pub struct Light {
     pub falloff: Falloff,
     #[serde(default)]
     pub radius: f64,
+    /// Point lights: irradiance falls as 1/d^p (overrides `falloff`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub falloff_power: Option<f64>,
 }
 
 fn white() -> Vec3 {
@@ -203,6 +246,15 @@ pub struct Material {
     pub transmission: f64,
     #[serde(default = "default_ior")]
     pub ior: f64,
+    /// Schlick Fresnel on the specular lobe: reflectance at normal
+    /// incidence F0 in (0, 1]; the lobe is scaled by F(H.V)/F0.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fresnel: Option<f64>,
+    /// A second Blinn-Phong lobe: its strength and exponent.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub specular2: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shininess2: Option<f64>,
 }
 
 fn one() -> f64 {

@@ -35,6 +35,7 @@ pub fn validate(scene: &Scene, file: &str) -> Result<()> {
     }
     non_negative3(file, "ambient", scene.ambient)?;
     camera(&scene.camera, file)?;
+    effects(scene, file)?;
     let mut seen = std::collections::HashSet::new();
     for (i, l) in scene.lights.iter().enumerate() {
         let at = format!("lights[{i}]");
@@ -196,10 +197,41 @@ fn camera(c: &Camera, file: &str) -> Result<()> {
     }
 }
 
+/// The optional effect fields of the scene and camera.
+fn effects(scene: &Scene, file: &str) -> Result<()> {
+    if let Some(k) = scene.indirect_light {
+        non_negative(file, "indirect_light", k)?;
+    }
+    if let Some(v) = scene.camera.vignetting {
+        if !(v.strength.is_finite() && v.strength <= 1.0) {
+            return Err(Error::invalid(
+                file,
+                "camera.vignetting.strength",
+                format!("expected a number up to 1, got {}", v.strength),
+            ));
+        }
+    }
+    if let Some(r) = scene.camera.response {
+        positive(file, "camera.response.gain", r.gain)?;
+        positive(file, "camera.response.gamma", r.gamma)?;
+        if !r.black.is_finite() {
+            return Err(Error::invalid(
+                file,
+                "camera.response.black",
+                "expected a finite number",
+            ));
+        }
+    }
+    Ok(())
+}
+
 fn light(l: &Light, file: &str, at: &str) -> Result<()> {
     non_negative3(file, &format!("{at}.color"), l.color)?;
     non_negative(file, &format!("{at}.intensity"), l.intensity)?;
     non_negative(file, &format!("{at}.radius"), l.radius)?;
+    if let Some(p) = l.falloff_power {
+        non_negative(file, &format!("{at}.falloff_power"), p)?;
+    }
     match l.kind {
         LightKind::Point => {
             let p = required(
@@ -329,7 +361,23 @@ fn material(m: &Material, file: &str, at: &str) -> Result<()> {
     positive(file, &key("shininess"), m.shininess)?;
     non_negative(file, &key("reflection"), m.reflection)?;
     non_negative(file, &key("transmission"), m.transmission)?;
-    positive(file, &key("ior"), m.ior)
+    positive(file, &key("ior"), m.ior)?;
+    if let Some(f0) = m.fresnel {
+        if !(f0 > 0.0 && f0 <= 1.0) {
+            return Err(Error::invalid(
+                file,
+                key("fresnel"),
+                format!("expected F0 in (0, 1], got {f0}"),
+            ));
+        }
+    }
+    if let Some(k) = m.specular2 {
+        non_negative(file, &key("specular2"), k)?;
+    }
+    if let Some(n) = m.shininess2 {
+        positive(file, &key("shininess2"), n)?;
+    }
+    Ok(())
 }
 
 fn free(scene: &Scene, f: &FreeParam, file: &str, at: &str) -> Result<()> {
@@ -418,7 +466,13 @@ fn free(scene: &Scene, f: &FreeParam, file: &str, at: &str) -> Result<()> {
                 _,
                 super::field::MaterialField::Shininess | super::field::MaterialField::Ior,
             ) => f64::MIN_POSITIVE,
-            Field::Camera(_) | Field::Shape(..) => f64::MIN_POSITIVE,
+            Field::Camera(
+                super::field::CameraField::FovY
+                | super::field::CameraField::Height
+                | super::field::CameraField::ResponseGain
+                | super::field::CameraField::ResponseGamma,
+            )
+            | Field::Shape(..) => f64::MIN_POSITIVE,
             _ => 0.0,
         };
         if lo[0] < physical_min {

@@ -4,8 +4,11 @@
 //! Blinn-Phong specular; mirror reflection and refraction to a depth limit.
 //! The shading equation is in `shade.rs` and docs/renderers.md.
 //!
-//! Reads from the scene: `camera`, `image`, `ambient`, `lights` (all but
-//! `radius`), `objects`, `render.antialias`, `render.max_depth`.
+//! Reads from the scene: `camera`, `image`, `ambient`, `indirect_light`,
+//! `lights` (with `radius` for soft shadows and `falloff_power`), `objects`
+//! (with `fresnel`, `specular2`, `shininess2`), `render.antialias`,
+//! `render.max_depth`. The camera's `vignetting` and `response` are applied
+//! after any renderer (render/camera_effects.rs).
 //!
 //! Speed: what camera rays hit is traced once per session when no free
 //! parameter moves geometry, and a candidate only re-shades those hits.
@@ -13,6 +16,7 @@
 //! deterministic.
 
 mod camera;
+mod effects;
 mod geometry;
 mod packed;
 mod paths;

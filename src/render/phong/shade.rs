@@ -9,6 +9,13 @@
 //! (point, no falloff) or E*color*cos(theta) (directional), and V the
 //! hard-shadow visibility.
 //!
+//! Optional effects (docs/scene-format.md "Effects"), each off unless its
+//! field is present, so the fast path stays as it was: a point light's
+//! `falloff_power` p (E ~ 1/d^p), a light's `radius` (soft shadows from
+//! several shadow rays, `effects.rs`), the material's `fresnel` F0 (the
+//! lobe scaled by Schlick's F(H.V)/F0) and second lobe (`specular2`,
+//! `shininess2`), and the scene's `indirect_light` (a one-bounce estimate).
+//!
 //! The per-light pass over all hits is written as plain loops over arrays
 //! so that the compiler vectorises it; on CPUs with AVX2 a copy compiled for
 //! it is chosen at run time.
@@ -33,6 +40,18 @@ struct Mat {
     min_cos: f32,
     reflection: f64,
     transmission: f64,
+    /// Schlick F0, when the specular lobe has Fresnel.
+    fresnel: Option<f32>,
+    /// The second lobe, normalised like the first, and its exponent.
+    spec2: f32,
+    shininess2: f32,
+}
+
+impl Mat {
+    /// True when the specular pass needs H.V per hit.
+    fn general_specular(&self) -> bool {
+        self.fresnel.is_some() || self.spec2 > 0.0
+    }
 }
 
 /// A light for one candidate.
@@ -42,6 +61,10 @@ struct Lamp {
     /// Position (point) or unit direction towards the light.
     at: [f32; 3],
     power: [f32; 3],
+    /// Exponent of a point light's distance falloff, when not 2 or 0.
+    falloff_power: Option<f32>,
+    /// Area light radius (point: metres; directional: angular radius, rad).
+    radius: f64,
 }
 
 /// Per-thread working arrays, kept between renders: allocating them anew
@@ -98,7 +121,23 @@ fn shade_into(
             continue;
         }
         irradiance(packed, &packed.lights[l], &lamp, e, nh);
-        complex_shadows(paths, &paths.geometry, l, &packed.lights[l], &lamp, e);
+        if lamp.radius > 0.0 {
+            super::effects::soft_shadows(
+                packed,
+                &paths.geometry,
+                lamp.point,
+                lamp.at,
+                lamp.radius,
+                lamp.falloff_power
+                    .unwrap_or(if lamp.inverse_square { 2.0 } else { 0.0 }),
+                e,
+            );
+        } else {
+            complex_shadows(paths, &paths.geometry, l, &packed.lights[l], &lamp, e);
+            if let Some(p) = lamp.falloff_power {
+                super::effects::falloff(packed, lamp.at, p, e);
+            }
+        }
         for grp in &packed.groups {
             let m = &mats[grp.object as usize];
             let range = grp.start..grp.end;
@@ -114,7 +153,18 @@ fn shade_into(
                 &mut g[range.clone()],
                 &mut b[range.clone()],
             );
-            if m.spec > 0.0 {
+            if m.general_specular() {
+                let lobes = super::effects::Lobes {
+                    spec: m.spec,
+                    shininess: m.shininess,
+                    spec2: m.spec2,
+                    shininess2: m.shininess2,
+                    fresnel: m.fresnel,
+                };
+                super::effects::specular(
+                    packed, range, &lobes, lamp.point, lamp.at, lamp.power, e, r, g, b,
+                );
+            } else if m.spec > 0.0 {
                 for i in range {
                     if e[i] > 0.0 && nh[i] > m.min_cos {
                         let s = m.spec * nh[i].powf(m.shininess) * e[i];
@@ -125,6 +175,10 @@ fn shade_into(
                 }
             }
         }
+    }
+    if let Some(k) = scene.indirect_light.filter(|&k| k > 0.0) {
+        let albedo: Vec<[f32; 3]> = mats.iter().map(|m| m.diffuse).collect();
+        super::effects::one_bounce(packed, &albedo, k as f32, r, g, b);
     }
     match &packed.direct_pixel {
         Some(pixel) => {
@@ -191,6 +245,11 @@ fn materials(scene: &Scene) -> Vec<Mat> {
                 min_cos: SPEC_CUTOFF.powf(1.0 / m.shininess) as f32,
                 reflection: m.reflection,
                 transmission: m.transmission,
+                fresnel: m.fresnel.map(|f| f as f32),
+                spec2: m.specular2.map_or(0.0, |k| {
+                    k * (m.shininess2.unwrap_or(m.shininess) + 8.0) / (8.0 * PI)
+                }) as f32,
+                shininess2: m.shininess2.unwrap_or(m.shininess) as f32,
             }
         })
         .collect()
@@ -204,9 +263,16 @@ fn lamp(l: &crate::scene::Light) -> Lamp {
     let p = V3::from(l.color) * l.intensity;
     Lamp {
         point: l.kind == LightKind::Point,
-        inverse_square: l.falloff == Falloff::InverseSquare,
+        // An explicit exponent replaces the named falloff: the kernel then
+        // runs without falloff and `effects::falloff` applies d^-p.
+        inverse_square: l.falloff == Falloff::InverseSquare && l.falloff_power.is_none(),
         at: [at.x as f32, at.y as f32, at.z as f32],
         power: [p.x as f32, p.y as f32, p.z as f32],
+        falloff_power: l
+            .falloff_power
+            .filter(|_| l.kind == LightKind::Point)
+            .map(|p| p as f32),
+        radius: l.radius,
     }
 }
 

@@ -1,0 +1,159 @@
+//! Image-space camera effects applied after any backend: vignetting and the
+//! camera's response curve (DESIGN.md effects `vignetting`,
+//! `camera_response`). A wrapper around every renderer, so no backend needs
+//! to know these fields.
+//!
+//! ```json
+//! "camera": {..., "vignetting": {"strength": 0.3},
+//!            "response": {"gain": 1.1, "gamma": 0.9, "black": 0.01}}
+//! ```
+//! Each 8-bit sRGB pixel is decoded to linear v, then
+//! `v * (1 - strength * r^2)` (r: distance from the image centre over the
+//! half-diagonal), then `black + gain * v^gamma`, then sRGB-encoded again.
+//! A scene without these fields passes through untouched.
+
+use super::srgb::{decode, encode};
+use super::{Image, RenderResult, RenderSession, Renderer};
+use crate::error::Result;
+use crate::scene::{Camera, ParamSpace, Scene};
+
+/// Any renderer, followed by the camera's image-space effects.
+pub struct WithCameraEffects(pub Box<dyn Renderer>);
+
+impl Renderer for WithCameraEffects {
+    fn name(&self) -> String {
+        self.0.name()
+    }
+
+    fn default_jobs(&self) -> usize {
+        self.0.default_jobs()
+    }
+
+    fn session(
+        &self,
+        base: &Scene,
+        varying: &ParamSpace,
+        jobs: usize,
+    ) -> Result<Box<dyn RenderSession>> {
+        // The backend never sees the image-space fields vary: they do not
+        // change what it renders.
+        let inner_space = ParamSpace {
+            specs: varying
+                .specs
+                .iter()
+                .filter(|s| !s.field.is_image_space())
+                .cloned()
+                .collect(),
+        };
+        Ok(Box::new(CameraEffectsSession {
+            inner: self.0.session(base, &inner_space, jobs)?,
+        }))
+    }
+}
+
+struct CameraEffectsSession {
+    inner: Box<dyn RenderSession>,
+}
+
+impl RenderSession for CameraEffectsSession {
+    fn describe(&self) -> String {
+        self.inner.describe()
+    }
+
+    fn render_batch(&mut self, scenes: &[Scene], seed: u64) -> Vec<RenderResult> {
+        let mut out = self.inner.render_batch(scenes, seed);
+        for (res, scene) in out.iter_mut().zip(scenes) {
+            if let Ok(img) = res {
+                apply(&scene.camera, img);
+            }
+        }
+        out
+    }
+}
+
+/// True when the camera has an image-space effect that changes pixels.
+pub fn has_effects(cam: &Camera) -> bool {
+    cam.vignetting.is_some_and(|v| v.strength != 0.0)
+        || cam
+            .response
+            .is_some_and(|r| r.gain != 1.0 || r.gamma != 1.0 || r.black != 0.0)
+}
+
+/// Applies the camera's vignetting and response to `img` in place.
+pub fn apply(cam: &Camera, img: &mut Image) {
+    if !has_effects(cam) {
+        return;
+    }
+    let lut: Vec<f64> = (0..=255u8).map(decode).collect();
+    let (w, h) = img.dimensions();
+    let (cx, cy) = (w as f64 / 2.0, h as f64 / 2.0);
+    let half_diag2 = cx * cx + cy * cy;
+    let k = cam.vignetting.map_or(0.0, |v| v.strength);
+    let resp = cam.response.unwrap_or_default();
+    for (x, y, px) in img.enumerate_pixels_mut() {
+        let (dx, dy) = (x as f64 + 0.5 - cx, y as f64 + 0.5 - cy);
+        let fall = 1.0 - k * (dx * dx + dy * dy) / half_diag2;
+        for c in px.0.iter_mut() {
+            let v = lut[*c as usize] * fall;
+            let v = resp.black + resp.gain * v.max(0.0).powf(resp.gamma);
+            *c = encode(v);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::{CameraKind, Response, Vignetting};
+
+    fn camera() -> Camera {
+        Camera {
+            kind: CameraKind::Perspective,
+            position: [0.0, 0.0, 5.0],
+            look_at: [0.0; 3],
+            up: [0.0, 1.0, 0.0],
+            fov_y_deg: Some(40.0),
+            height: None,
+            vignetting: None,
+            response: None,
+        }
+    }
+
+    #[test]
+    fn identity_leaves_pixels_alone() {
+        let mut cam = camera();
+        cam.response = Some(Response::default());
+        cam.vignetting = Some(Vignetting { strength: 0.0 });
+        let img0 = Image::from_fn(8, 6, |x, y| {
+            image::Rgb([(x * 30) as u8, (y * 40) as u8, 77])
+        });
+        let mut img = img0.clone();
+        apply(&cam, &mut img);
+        assert_eq!(img, img0);
+    }
+
+    #[test]
+    fn vignetting_darkens_corners_not_centre() {
+        let mut cam = camera();
+        cam.vignetting = Some(Vignetting { strength: 0.5 });
+        let mut img = Image::from_pixel(64, 48, image::Rgb([200, 200, 200]));
+        apply(&cam, &mut img);
+        assert!(img.get_pixel(32, 24)[0] >= 199);
+        // r ~ 1 at the corner: half the linear value.
+        let expect = encode(decode(200) * 0.5) as i32;
+        assert!((img.get_pixel(0, 0)[0] as i32 - expect).abs() <= 3);
+    }
+
+    #[test]
+    fn response_gain_scales_linear_values() {
+        let mut cam = camera();
+        cam.response = Some(Response {
+            gain: 0.5,
+            gamma: 1.0,
+            black: 0.0,
+        });
+        let mut img = Image::from_pixel(2, 2, image::Rgb([188, 188, 188]));
+        apply(&cam, &mut img);
+        assert_eq!(img.get_pixel(0, 0)[0], encode(decode(188) * 0.5));
+    }
+}
