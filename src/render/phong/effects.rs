@@ -27,14 +27,14 @@ fn normal(pk: &Packed, i: usize) -> V3 {
 
 /// Multiplies each lit hit's irradiance by d^-p, d its distance to the light.
 pub fn falloff(pk: &Packed, light: [f32; 3], p: f32, e: &mut [f32]) {
-    for i in 0..pk.n {
-        if e[i] > 0.0 {
+    for (i, ei) in e.iter_mut().enumerate().take(pk.n) {
+        if *ei > 0.0 {
             let (dx, dy, dz) = (
                 light[0] - pk.px[i],
                 light[1] - pk.py[i],
                 light[2] - pk.pz[i],
             );
-            e[i] *= (dx * dx + dy * dy + dz * dz).powf(-0.5 * p);
+            *ei *= (dx * dx + dy * dy + dz * dz).powf(-0.5 * p);
         }
     }
 }
