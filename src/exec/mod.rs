@@ -14,6 +14,7 @@ pub mod oneshot;
 pub mod output;
 pub mod pool;
 pub mod process;
+pub mod stats;
 pub mod tail;
 pub mod worker;
 

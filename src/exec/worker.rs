@@ -151,6 +151,18 @@ impl Worker {
         timeout: Duration,
     ) -> Result<(), RequestError> {
         self.mark = self.tail.mark();
+        let started = std::time::Instant::now();
+        let result = self.exchange(line, id, timeout).await;
+        super::stats::record(started.elapsed());
+        result
+    }
+
+    async fn exchange(
+        &mut self,
+        line: &str,
+        id: u64,
+        timeout: Duration,
+    ) -> Result<(), RequestError> {
         let deadline = Instant::now() + timeout;
         let sent = tokio::time::timeout_at(deadline, async {
             self.stdin.write_all(line.as_bytes()).await?;

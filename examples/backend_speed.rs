@@ -1,0 +1,93 @@
+//! Renders per second of a backend inside a fit, and the share of the
+//! pool's time spent outside the renderer: a fit of scenes/sphere_floor.json
+//! (128x96, 16 samples, its five free parameters) to a target the same
+//! backend rendered. Figures in docs/benchmarks-backends.md.
+//!
+//! cargo run --release --example backend_speed -- RENDERER [--jobs N]
+//!     [--population P] [--generations G] [--direct]
+//!
+//! `--direct` sets `render.indirect` false. Renders/s counts the fit's
+//! evaluations over its wall time (worker start-up excluded, as the fit
+//! reports it); "outside" is 1 - (time renderers were busy) / (slots x
+//! wall time), slots = min(jobs, population).
+
+use scenefit::exec::stats;
+use scenefit::fit::{self, FitConfig, FitTarget};
+use scenefit::optimize::DeConfig;
+use scenefit::render::{from_spec, render_one};
+use scenefit::scene::load;
+use std::path::Path;
+
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let Some(renderer_name) = args.first().cloned() else {
+        eprintln!("usage: backend_speed RENDERER [--jobs N] [--population P] [--generations G] [--direct]");
+        std::process::exit(2);
+    };
+    let value = |flag: &str| {
+        args.iter()
+            .position(|a| a == flag)
+            .and_then(|i| args.get(i + 1))
+            .and_then(|v| v.parse::<usize>().ok())
+    };
+    let renderer = from_spec(&renderer_name).unwrap_or_else(|e| fail(&e.to_string()));
+    let jobs = value("--jobs").unwrap_or_else(|| renderer.default_jobs());
+    let population = value("--population").unwrap_or(80);
+    let generations = value("--generations").unwrap_or(3);
+
+    let mut scene = load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/sphere_floor.json"))
+        .unwrap_or_else(|e| fail(&e.to_string()));
+    scene.render.samples = 16;
+    if args.iter().any(|a| a == "--direct") {
+        scene.render.indirect = false;
+    }
+    let target = render_one(renderer.as_ref(), &scene, 0).unwrap_or_else(|e| fail(&e.to_string()));
+    let dir = tempfile::tempdir().unwrap_or_else(|e| fail(&e.to_string()));
+    let config = FitConfig {
+        de: DeConfig {
+            population,
+            seed: 5,
+            ..DeConfig::default()
+        },
+        generations,
+        jobs,
+        snapshot_every: 1000,
+        ..FitConfig::default()
+    };
+    stats::reset();
+    let started = std::time::Instant::now();
+    let result = fit::run(
+        &scene,
+        &FitTarget {
+            image: target,
+            mask: None,
+            path: None,
+        },
+        renderer.as_ref(),
+        &config,
+        dir.path(),
+        &mut (),
+    )
+    .unwrap_or_else(|e| fail(&e.to_string()));
+    let total = started.elapsed().as_secs_f64();
+    let (attempts, busy) = stats::snapshot();
+    let wall = result.wall_seconds;
+    let slots = jobs.min(population) as f64;
+    let outside = 1.0 - busy.as_secs_f64() / (slots * wall);
+    println!(
+        "{renderer_name}: jobs {jobs}, population {population}, {} renders in {wall:.2} s = {:.1} renders/s; \
+         renderer busy {:.1} % of {slots} slots, outside {:.1} %; {attempts} attempts, {} failed; \
+         run incl. start-up {total:.2} s; deviation {:.3} %",
+        result.evaluations,
+        result.evaluations as f64 / wall,
+        100.0 * (1.0 - outside),
+        100.0 * outside,
+        result.failed_renders,
+        result.deviation.average
+    );
+}
+
+fn fail(msg: &str) -> ! {
+    eprintln!("error: {msg}");
+    std::process::exit(1)
+}
