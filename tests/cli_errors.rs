@@ -21,7 +21,10 @@ fn edited(edit: impl FnOnce(&mut serde_json::Value)) -> String {
 fn assert_user_error(out: &std::process::Output, needles: &[&str]) {
     let err = stderr(out);
     assert_eq!(out.status.code(), Some(2), "exit code; stderr: {err}");
-    assert!(!err.contains("panicked") && !err.contains("RUST_BACKTRACE"), "no panic: {err}");
+    assert!(
+        !err.contains("panicked") && !err.contains("RUST_BACKTRACE"),
+        "no panic: {err}"
+    );
     let lines: Vec<&str> = err.lines().filter(|l| !l.trim().is_empty()).collect();
     assert_eq!(lines.len(), 1, "one line: {err}");
     for n in needles {
@@ -36,64 +39,127 @@ fn render(dir: &Path, scene: &str) -> std::process::Output {
 #[test]
 fn malformed_json_names_file_and_line() {
     let d = tempfile::tempdir().unwrap();
-    let f = write(d.path(), "bad.json", "{\"format\": \"scenefit-scene/1\",\n  \"image\": {\"width\": 128,, }");
-    assert_user_error(&render(d.path(), &f), &["bad.json", "line 2", "not valid JSON"]);
+    let f = write(
+        d.path(),
+        "bad.json",
+        "{\"format\": \"scenefit-scene/1\",\n  \"image\": {\"width\": 128,, }",
+    );
+    assert_user_error(
+        &render(d.path(), &f),
+        &["bad.json", "line 2", "not valid JSON"],
+    );
 }
 
 #[test]
 fn unknown_key_is_named_with_its_path() {
     let d = tempfile::tempdir().unwrap();
-    let f = write(d.path(), "s.json", &edited(|v| v["objects"][0]["material"]["colour"] = serde_json::json!([1, 0, 0])));
-    assert_user_error(&render(d.path(), &f), &["s.json", "objects[0].material", "unknown field `colour`"]);
+    let f = write(
+        d.path(),
+        "s.json",
+        &edited(|v| v["objects"][0]["material"]["colour"] = serde_json::json!([1, 0, 0])),
+    );
+    assert_user_error(
+        &render(d.path(), &f),
+        &["s.json", "objects[0].material", "unknown field `colour`"],
+    );
 }
 
 #[test]
 fn min_above_max_is_rejected() {
     let d = tempfile::tempdir().unwrap();
-    let f = write(d.path(), "s.json", &edited(|v| v["free"][1] = serde_json::json!({"param": "lights.key.intensity", "min": 50, "max": 1})));
-    assert_user_error(&render(d.path(), &f), &["s.json", "free[1].max", "max >= min"]);
+    let f = write(
+        d.path(),
+        "s.json",
+        &edited(|v| {
+            v["free"][1] = serde_json::json!({"param": "lights.key.intensity", "min": 50, "max": 1})
+        }),
+    );
+    assert_user_error(
+        &render(d.path(), &f),
+        &["s.json", "free[1].max", "max >= min"],
+    );
 }
 
 #[test]
 fn free_parameter_naming_a_missing_object() {
     let d = tempfile::tempdir().unwrap();
-    let f = write(d.path(), "s.json", &edited(|v| v["free"][2]["param"] = serde_json::json!("objects.teapot.material.color")));
-    assert_user_error(&render(d.path(), &f), &["s.json", "free[2].param", "no object named \"teapot\""]);
+    let f = write(
+        d.path(),
+        "s.json",
+        &edited(|v| v["free"][2]["param"] = serde_json::json!("objects.teapot.material.color")),
+    );
+    assert_user_error(
+        &render(d.path(), &f),
+        &["s.json", "free[2].param", "no object named \"teapot\""],
+    );
 }
 
 #[test]
 fn negative_radius() {
     let d = tempfile::tempdir().unwrap();
-    let f = write(d.path(), "s.json", &edited(|v| v["objects"][0]["shape"]["radius"] = serde_json::json!(-0.5)));
-    assert_user_error(&render(d.path(), &f), &["s.json", "objects[0].shape.radius", "positive"]);
+    let f = write(
+        d.path(),
+        "s.json",
+        &edited(|v| v["objects"][0]["shape"]["radius"] = serde_json::json!(-0.5)),
+    );
+    assert_user_error(
+        &render(d.path(), &f),
+        &["s.json", "objects[0].shape.radius", "positive"],
+    );
 }
 
 #[test]
 fn degenerate_camera_up_parallel_to_view() {
     let d = tempfile::tempdir().unwrap();
-    let f = write(d.path(), "s.json", &edited(|v| {
-        v["camera"]["position"] = serde_json::json!([0, 5, 0]);
-        v["camera"]["look_at"] = serde_json::json!([0, 0, 0]);
-        v["camera"]["up"] = serde_json::json!([0, 1, 0]);
-    }));
+    let f = write(
+        d.path(),
+        "s.json",
+        &edited(|v| {
+            v["camera"]["position"] = serde_json::json!([0, 5, 0]);
+            v["camera"]["look_at"] = serde_json::json!([0, 0, 0]);
+            v["camera"]["up"] = serde_json::json!([0, 1, 0]);
+        }),
+    );
     assert_user_error(&render(d.path(), &f), &["s.json", "camera.up", "parallel"]);
 }
 
 #[test]
 fn wrong_type_names_key_and_expectation() {
     let d = tempfile::tempdir().unwrap();
-    let f = write(d.path(), "s.json", &edited(|v| v["lights"][0]["intensity"] = serde_json::json!("bright")));
-    assert_user_error(&render(d.path(), &f), &["s.json", "lights[0].intensity", "expected f64"]);
+    let f = write(
+        d.path(),
+        "s.json",
+        &edited(|v| v["lights"][0]["intensity"] = serde_json::json!("bright")),
+    );
+    assert_user_error(
+        &render(d.path(), &f),
+        &["s.json", "lights[0].intensity", "expected f64"],
+    );
 }
 
 #[test]
 fn missing_scene_file() {
     let d = tempfile::tempdir().unwrap();
-    assert_user_error(&render(d.path(), "nope.json"), &["nope.json", "No such file"]);
+    assert_user_error(
+        &render(d.path(), "nope.json"),
+        &["nope.json", "No such file"],
+    );
 }
 
 fn fit_args<'a>(scene: &'a str, target: &'a str) -> Vec<&'a str> {
-    vec!["fit", scene, "--target", target, "-o", "run", "--generations", "2", "--population", "8", "-q"]
+    vec![
+        "fit",
+        scene,
+        "--target",
+        target,
+        "-o",
+        "run",
+        "--generations",
+        "2",
+        "--population",
+        "8",
+        "-q",
+    ]
 }
 
 #[test]
@@ -108,12 +174,20 @@ fn missing_target() {
 fn truncated_target() {
     let d = tempfile::tempdir().unwrap();
     let scene = scenes().join("sphere_floor.json");
-    assert!(scenefit(d.path(), &["render", scene.to_str().unwrap(), "-o", "t.png"]).status.success());
+    assert!(scenefit(
+        d.path(),
+        &["render", scene.to_str().unwrap(), "-o", "t.png"]
+    )
+    .status
+    .success());
     let bytes = std::fs::read(d.path().join("t.png")).unwrap();
     std::fs::write(d.path().join("cut.png"), &bytes[..bytes.len() / 2]).unwrap();
     let out = scenefit(d.path(), &fit_args(scene.to_str().unwrap(), "cut.png"));
     assert_user_error(&out, &["cut.png", "--target", "could not decode"]);
-    assert!(!d.path().join("run/result.json").exists(), "no result from a failed start");
+    assert!(
+        !d.path().join("run/result.json").exists(),
+        "no result from a failed start"
+    );
 }
 
 #[test]
@@ -121,7 +195,21 @@ fn target_of_the_wrong_size() {
     let d = tempfile::tempdir().unwrap();
     let scene = scenes().join("sphere_floor.json");
     let s = scene.to_str().unwrap();
-    assert!(scenefit(d.path(), &["render", s, "-o", "small.png", "--width", "64", "--height", "48"]).status.success());
+    assert!(scenefit(
+        d.path(),
+        &[
+            "render",
+            s,
+            "-o",
+            "small.png",
+            "--width",
+            "64",
+            "--height",
+            "48"
+        ]
+    )
+    .status
+    .success());
     let out = scenefit(d.path(), &fit_args(s, "small.png"));
     assert_user_error(&out, &["small.png", "expected 128x96", "got 64x48"]);
 }
@@ -131,7 +219,9 @@ fn bad_option_values() {
     let d = tempfile::tempdir().unwrap();
     let scene = scenes().join("sphere_floor.json");
     let s = scene.to_str().unwrap();
-    assert!(scenefit(d.path(), &["render", s, "-o", "t.png"]).status.success());
+    assert!(scenefit(d.path(), &["render", s, "-o", "t.png"])
+        .status
+        .success());
     let cases: &[(&[&str], &[&str])] = &[
         (&["--strategy", "simplex"], &["simplex", "rand1bin"]),
         (&["--population", "2"], &["population"]),
@@ -144,9 +234,22 @@ fn bad_option_values() {
         args.extend_from_slice(extra);
         assert_user_error(&scenefit(d.path(), &args), needles);
     }
-    let out = scenefit(d.path(), &["render", s, "-o", "x.png", "--renderer", "raytracer9000"]);
+    let out = scenefit(
+        d.path(),
+        &["render", s, "-o", "x.png", "--renderer", "raytracer9000"],
+    );
     assert_user_error(&out, &["--renderer raytracer9000", "expected phong"]);
-    let out = scenefit(d.path(), &["render", s, "-o", "x.png", "--set", "lights.nope.position=[1,2,3]"]);
+    let out = scenefit(
+        d.path(),
+        &[
+            "render",
+            s,
+            "-o",
+            "x.png",
+            "--set",
+            "lights.nope.position=[1,2,3]",
+        ],
+    );
     assert_user_error(&out, &["lights.nope.position", "no entry named \"nope\""]);
 }
 
@@ -155,8 +258,22 @@ fn set_overrides_a_field() {
     let d = tempfile::tempdir().unwrap();
     let scene = scenes().join("sphere_floor.json");
     let s = scene.to_str().unwrap();
-    assert!(scenefit(d.path(), &["render", s, "-o", "a.png"]).status.success());
-    assert!(scenefit(d.path(), &["render", s, "-o", "b.png", "--set", "objects.ball.material.color=[0.1,0.2,0.9]"]).status.success());
+    assert!(scenefit(d.path(), &["render", s, "-o", "a.png"])
+        .status
+        .success());
+    assert!(scenefit(
+        d.path(),
+        &[
+            "render",
+            s,
+            "-o",
+            "b.png",
+            "--set",
+            "objects.ball.material.color=[0.1,0.2,0.9]"
+        ]
+    )
+    .status
+    .success());
     let a = image::open(d.path().join("a.png")).unwrap().to_rgb8();
     let b = image::open(d.path().join("b.png")).unwrap().to_rgb8();
     assert_ne!(a, b, "--set should change the ball's colour");
