@@ -3,6 +3,7 @@
 //! scene -> parameter vector -> renderer -> image -> metric -> optimizer.
 
 pub mod cli;
+pub mod diagnose;
 pub mod error;
 pub mod exec;
 pub mod fit;

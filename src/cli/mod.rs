@@ -3,6 +3,7 @@
 //! and turns errors into one line and an exit code.
 
 mod demo;
+mod diagnose;
 mod fit;
 mod progress;
 mod render;
@@ -28,6 +29,8 @@ enum Command {
     Render(render::RenderArgs),
     /// Fit a scene's free parameters to a target image.
     Fit(fit::FitArgs),
+    /// Find the effect a fit's model lacks, add it, refit, report before and after.
+    Diagnose(diagnose::DiagnoseArgs),
 }
 
 /// Runs the command line; returns the process exit code.
@@ -50,6 +53,7 @@ pub fn main() -> i32 {
         Command::Demo(a) => demo::run(a),
         Command::Render(a) => render::run(a),
         Command::Fit(a) => fit::run(a),
+        Command::Diagnose(a) => diagnose::run(a),
     };
     match result {
         Ok(()) => 0,

@@ -1,0 +1,78 @@
+//! `scenefit diagnose FIT_DIR -o DIR`: find the effect a fit's model lacks,
+//! add it, refit, report before and after (src/diagnose/).
+
+use crate::diagnose::{self, DiagnoseConfig, Inputs};
+use crate::error::{Error, Result};
+use clap::Args;
+use std::path::PathBuf;
+
+#[derive(Args, Debug)]
+pub struct DiagnoseArgs {
+    /// A directory written by `scenefit fit`.
+    fit_dir: PathBuf,
+    /// Where the diagnosis goes.
+    #[arg(short, long)]
+    output: PathBuf,
+    /// The target (default: the one named in FIT_DIR/result.json).
+    #[arg(long)]
+    target: Option<PathBuf>,
+    /// Pixels that count (default: FIT_DIR/mask.png when present).
+    #[arg(long)]
+    mask: Option<PathBuf>,
+    /// The renderer of the refits.
+    #[arg(long, default_value = "phong")]
+    renderer: String,
+    /// DE population of each refit.
+    #[arg(long, default_value_t = 16)]
+    population: usize,
+    /// Generations of each refit (searching the effect, then refining all).
+    #[arg(long, default_value_t = 65)]
+    generations: usize,
+    /// Effects accepted at most.
+    #[arg(long, default_value_t = 3)]
+    max_effects: usize,
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Renders at once (default: the number of cores).
+    #[arg(long)]
+    jobs: Option<usize>,
+}
+
+pub fn run(a: DiagnoseArgs) -> Result<()> {
+    if a.population < 4 || a.generations < 2 {
+        return Err(Error::Usage(
+            "--population must be at least 4 and --generations at least 2".into(),
+        ));
+    }
+    if a.jobs == Some(0) {
+        return Err(Error::Usage("--jobs: expected 1 or more".into()));
+    }
+    let inputs = Inputs::from_fit_dir(&a.fit_dir, a.target.as_deref(), a.mask.as_deref())?;
+    let mut config = DiagnoseConfig {
+        renderer: a.renderer,
+        population: a.population,
+        search_generations: (a.generations * 2 / 5).max(1),
+        refine_generations: (a.generations - (a.generations * 2 / 5).max(1)).max(1),
+        max_rounds: a.max_effects,
+        seed: a.seed,
+        ..DiagnoseConfig::default()
+    };
+    if let Some(j) = a.jobs {
+        config.jobs = j;
+    }
+    let d = diagnose::run(&inputs, &a.output, &config)?;
+    println!(
+        "deviation {:.3} % -> {:.3} %; accepted: {}; {} renders in {:.1} s; results in {}",
+        d.deviation_before.average,
+        d.deviation_after.average,
+        if d.accepted.is_empty() {
+            "none".into()
+        } else {
+            d.accepted.join(", ")
+        },
+        d.renders,
+        d.wall_seconds,
+        a.output.display()
+    );
+    Ok(())
+}

@@ -1,0 +1,403 @@
+//! `scenefit diagnose`: trace the residual of a finished fit to the effect
+//! the model lacks, add it, refit, and report the error before and after
+//! (DESIGN.md "diagnose", docs/diagnose.md).
+//!
+//! Each round scores every applicable effect by how much of the residual
+//! its feature maps explain (`residual.rs`), then confirms each by a refit
+//! with the effect added (`library.rs`): first the effect's own parameters
+//! alone, searched over their bounds, then everything, warm-started around
+//! the result (`fit::run` with `start_radius`). An effect is accepted when
+//! its refit lowers the Bayesian information criterion on the pixel
+//! residuals, `N ln(RSS/N) + k ln N` (k: free parameters), by more than a
+//! margin, and the residual sum of squares by at least `min_gain`. The
+//! comparison is against a refit of the unchanged model with the same
+//! budget, so that further convergence is not credited to an effect.
+//! Rounds repeat until nothing is accepted; `unexplained` is reported when
+//! smooth structure remains in the residual.
+
+pub mod library;
+pub mod report;
+pub mod residual;
+
+use crate::error::{Error, Result};
+use crate::fit::{self, FitConfig, FitResult, FitTarget};
+use crate::metric::{deviation, Deviation, Mask};
+use crate::optimize::DeConfig;
+use crate::render::{from_spec, image_io, render_one, Image, Renderer};
+use crate::scene::{ParamSpace, Scene};
+use residual::Residual;
+use serde::Serialize;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// How a diagnosis searches.
+#[derive(Clone, Debug)]
+pub struct DiagnoseConfig {
+    pub renderer: String,
+    /// DE population of each refit.
+    pub population: usize,
+    /// Generations searching the new effect's parameters alone.
+    pub search_generations: usize,
+    /// Generations refining every parameter together.
+    pub refine_generations: usize,
+    /// Unit-cube radius of the warm start of the joint refit.
+    pub start_radius: f64,
+    /// Effects accepted at most.
+    pub max_rounds: usize,
+    /// Least relative drop of the residual sum of squares to accept.
+    pub min_gain: f64,
+    /// BIC must drop by more than this.
+    pub bic_margin: f64,
+    pub seed: u64,
+    pub jobs: usize,
+}
+
+impl Default for DiagnoseConfig {
+    fn default() -> Self {
+        DiagnoseConfig {
+            renderer: "phong".into(),
+            population: 16,
+            search_generations: 25,
+            refine_generations: 40,
+            start_radius: 0.08,
+            max_rounds: 3,
+            min_gain: 0.05,
+            bic_margin: 10.0,
+            seed: 1,
+            jobs: std::thread::available_parallelism()
+                .map(|n| n.get())
+                .unwrap_or(1),
+        }
+    }
+}
+
+/// What a diagnosis starts from.
+pub struct Inputs {
+    pub scene: Scene,
+    pub target: Image,
+    pub mask: Option<Mask>,
+}
+
+impl Inputs {
+    /// Reads a fit directory: fitted_scene.json, and the target named in
+    /// result.json (or `target`); the mask from `mask`, else FIT_DIR/mask.png
+    /// when present.
+    pub fn from_fit_dir(dir: &Path, target: Option<&Path>, mask: Option<&Path>) -> Result<Inputs> {
+        let scene = crate::scene::load(&dir.join("fitted_scene.json"))?;
+        let target_path: PathBuf = match target {
+            Some(t) => t.to_path_buf(),
+            None => {
+                let result = FitResult::load(dir)?;
+                let t = result.target.ok_or_else(|| {
+                    Error::Usage(format!(
+                        "{}: result.json names no target; give --target",
+                        dir.display()
+                    ))
+                })?;
+                let p = PathBuf::from(&t);
+                if p.exists() || p.is_absolute() {
+                    p
+                } else {
+                    dir.join(p)
+                }
+            }
+        };
+        let (w, h) = (scene.image.width, scene.image.height);
+        let target = image_io::read_target(&target_path, w, h)?;
+        let default_mask = dir.join("mask.png");
+        let mask_path = mask
+            .map(Path::to_path_buf)
+            .or_else(|| default_mask.exists().then_some(default_mask));
+        let mask = mask_path.map(|m| Mask::load(&m, w, h)).transpose()?;
+        Ok(Inputs {
+            scene,
+            target,
+            mask,
+        })
+    }
+}
+
+/// One effect tried in one round.
+#[derive(Clone, Debug, Serialize)]
+pub struct Candidate {
+    pub effect: String,
+    /// R² of the residual on the effect's feature maps.
+    pub evidence: f64,
+    /// The deviation after its refit (None: not applicable).
+    pub deviation_after: Option<Deviation>,
+    pub round: usize,
+    /// BIC after its refit minus BIC of the model it extends.
+    pub delta_bic: Option<f64>,
+    /// Relative drop of the residual sum of squares.
+    pub gain: Option<f64>,
+    pub added_params: usize,
+    pub accepted: bool,
+}
+
+/// diagnosis.json (DESIGN.md keys first).
+#[derive(Clone, Debug, Serialize)]
+pub struct Diagnosis {
+    pub deviation_before: Deviation,
+    pub deviation_after: Deviation,
+    pub candidates: Vec<Candidate>,
+    pub accepted: Vec<String>,
+    pub params_after: serde_json::Map<String, serde_json::Value>,
+    /// The deviation of the unchanged model refitted with the same budget.
+    pub deviation_refined: Deviation,
+    /// Smooth structure remains that no effect explained.
+    pub unexplained: bool,
+    pub renders: usize,
+    pub wall_seconds: f64,
+}
+
+/// The state of the model between rounds.
+struct Model {
+    scene: Scene,
+    image: Image,
+    rss: f64,
+}
+
+fn rss(target: &Image, render: &Image, mask: Option<&Mask>) -> f64 {
+    let (t, r) = (target.as_raw(), render.as_raw());
+    let sq = |i: usize| (t[i] as f64 - r[i] as f64).powi(2);
+    match mask {
+        Some(m) => m
+            .pixels()
+            .iter()
+            .map(|&p| (0..3).map(|c| sq(3 * p as usize + c)).sum::<f64>())
+            .sum(),
+        None => (0..t.len()).map(sq).sum(),
+    }
+}
+
+fn samples(target: &Image, mask: Option<&Mask>) -> f64 {
+    3.0 * mask.map_or((target.width() * target.height()) as usize, |m| {
+        m.pixels().len()
+    }) as f64
+}
+
+fn bic(rss: f64, n: f64, k: usize) -> f64 {
+    n * (rss.max(1e-9) / n).ln() + k as f64 * n.ln()
+}
+
+/// Runs the diagnosis, writing its files into `out`.
+pub fn run(inputs: &Inputs, out: &Path, config: &DiagnoseConfig) -> Result<Diagnosis> {
+    let started = Instant::now();
+    std::fs::create_dir_all(out).map_err(|e| Error::io(out, e))?;
+    let renderer = from_spec(&config.renderer)?;
+    let target = &inputs.target;
+    let mask = inputs.mask.as_ref();
+    let n = samples(target, mask);
+    let mut renders = 0usize;
+
+    let image0 = render_one(renderer.as_ref(), &inputs.scene, 0)?;
+    let before = deviation(target, &image0, mask);
+    let residual_before = Residual::new(target, &image0, mask);
+    let mut model = Model {
+        rss: rss(target, &image0, mask),
+        scene: inputs.scene.clone(),
+        image: image0,
+    };
+    let refits = out.join("refits");
+
+    // The unchanged model, refitted with the budget an effect gets.
+    let null = refit(
+        renderer.as_ref(),
+        &model.scene,
+        None,
+        inputs,
+        config,
+        &refits.join("none_0"),
+        config.search_generations + config.refine_generations,
+    )?;
+    renders += null.2;
+    if null.1 < model.rss {
+        model = Model {
+            scene: null.0,
+            rss: null.1,
+            image: null.3,
+        };
+    }
+    let refined = deviation(target, &model.image, mask);
+
+    let mut candidates = Vec::new();
+    let mut accepted = Vec::new();
+    for round in 1..=config.max_rounds {
+        let res = Residual::new(target, &model.image, mask);
+        let k0 = ParamSpace::from_scene(&model.scene).dim();
+        let bic0 = bic(model.rss, n, k0);
+        let mut tried: Vec<(Candidate, Option<Model>)> = Vec::new();
+        for effect in library::EFFECTS {
+            if accepted.iter().any(|a| a == effect) {
+                continue;
+            }
+            let evidence = res.evidence(effect);
+            let Some(ext) = library::extend(&model.scene, effect) else {
+                continue;
+            };
+            let added = ParamSpace::from_scene(&ext.scene).dim() - k0;
+            let (scene, r, count, image) = refit(
+                renderer.as_ref(),
+                &ext.scene,
+                Some(&ext.added),
+                inputs,
+                config,
+                &refits.join(format!("{effect}_{round}")),
+                config.refine_generations,
+            )?;
+            renders += count;
+            let dev = deviation(target, &image, mask);
+            let delta = bic(r, n, k0 + added) - bic0;
+            let gain = 1.0 - r / model.rss.max(1e-9);
+            tried.push((
+                Candidate {
+                    effect: effect.to_string(),
+                    evidence,
+                    deviation_after: Some(dev),
+                    round,
+                    delta_bic: Some(delta),
+                    gain: Some(gain),
+                    added_params: added,
+                    accepted: false,
+                },
+                Some(Model {
+                    scene,
+                    rss: r,
+                    image,
+                }),
+            ));
+        }
+        // Ranked by evidence for the report; chosen by the criterion.
+        tried.sort_by(|a, b| b.0.evidence.total_cmp(&a.0.evidence));
+        let best = tried
+            .iter()
+            .enumerate()
+            .filter(|(_, (c, _))| {
+                c.delta_bic.is_some_and(|d| d < -config.bic_margin)
+                    && c.gain.is_some_and(|g| g >= config.min_gain)
+            })
+            .min_by(|a, b| {
+                a.1 .0
+                    .delta_bic
+                    .unwrap_or(0.0)
+                    .total_cmp(&b.1 .0.delta_bic.unwrap_or(0.0))
+            })
+            .map(|(i, _)| i);
+        let _ = bic0;
+        let mut next = None;
+        for (i, (mut c, m)) in tried.into_iter().enumerate() {
+            if Some(i) == best {
+                c.accepted = true;
+                accepted.push(c.effect.clone());
+                next = m;
+            }
+            candidates.push(c);
+        }
+        match next {
+            Some(m) => model = m,
+            None => break,
+        }
+    }
+    let after = deviation(target, &model.image, mask);
+    let residual_after = Residual::new(target, &model.image, mask);
+    let unexplained = residual_after.structured();
+    let mut accepted_out = accepted.clone();
+    if unexplained {
+        accepted_out.push("unexplained".into());
+    }
+    let space = ParamSpace::from_scene(&model.scene);
+    let diagnosis = Diagnosis {
+        deviation_before: before,
+        deviation_after: after,
+        candidates,
+        accepted: accepted_out,
+        params_after: space.json_values(&model.scene),
+        deviation_refined: refined,
+        unexplained,
+        renders,
+        wall_seconds: started.elapsed().as_secs_f64(),
+    };
+    report::write(
+        out,
+        &diagnosis,
+        &model.scene,
+        &model.image,
+        &residual_before,
+        &residual_after,
+    )?;
+    Ok(diagnosis)
+}
+
+/// Refits `scene`: when `added` is given, first those parameters alone over
+/// their bounds, then all parameters warm-started around the result.
+/// Returns the scene, its residual sum of squares, the renders spent and
+/// the image.
+fn refit(
+    renderer: &dyn Renderer,
+    scene: &Scene,
+    added: Option<&[crate::scene::FreeParam]>,
+    inputs: &Inputs,
+    config: &DiagnoseConfig,
+    dir: &Path,
+    refine_generations: usize,
+) -> Result<(Scene, f64, usize, Image)> {
+    let target = FitTarget {
+        image: inputs.target.clone(),
+        mask: inputs.mask.clone(),
+        path: None,
+    };
+    let base = FitConfig {
+        de: DeConfig {
+            population: config.population,
+            seed: config.seed,
+            ..DeConfig::default()
+        },
+        jobs: config.jobs,
+        snapshot_every: usize::MAX / 2,
+        ..FitConfig::default()
+    };
+    let mut current = scene.clone();
+    let mut renders = 0;
+    if let Some(added) = added {
+        // The effect's parameters over their whole bounds, with the light
+        // intensities (an effect often changes the overall level: a falloff
+        // exponent moves it by a factor of d). The unchanged model is one
+        // individual of the start, so the search cannot end worse.
+        let mut only = current.clone();
+        only.free = scene
+            .free
+            .iter()
+            .filter(|f| f.param.starts_with("lights.") && f.param.ends_with(".intensity"))
+            .filter(|f| !added.iter().any(|a| a.param == f.param))
+            .cloned()
+            .chain(added.iter().cloned())
+            .collect();
+        let c = FitConfig {
+            generations: config.search_generations,
+            start_radius: Some(1.0),
+            ..base.clone()
+        };
+        let r = fit::run(&only, &target, renderer, &c, &dir.join("search"), &mut ())?;
+        renders += r.evaluations;
+        current = crate::scene::load(&dir.join("search").join("fitted_scene.json"))?;
+        current.free = scene.free.clone();
+    }
+    let c = FitConfig {
+        generations: refine_generations,
+        start_radius: Some(config.start_radius),
+        ..base
+    };
+    let r = fit::run(
+        &current,
+        &target,
+        renderer,
+        &c,
+        &dir.join("refine"),
+        &mut (),
+    )?;
+    renders += r.evaluations;
+    let fitted = crate::scene::load(&dir.join("refine").join("fitted_scene.json"))?;
+    let image = image_io::read_image(&dir.join("refine").join("best.png"), "best.png")?;
+    let s = rss(&inputs.target, &image, inputs.mask.as_ref());
+    Ok((fitted, s, renders, image))
+}
