@@ -5,7 +5,7 @@
 //! -- --threads 1`. Blender's start-up (over a second) is paid once per
 //! worker, not per render.
 //!
-//! Scene fields: all of them, mapped by the worker (its module docstring;
+//! Scene fields: all but what `pbr_fields.rs` refuses, mapped by the worker (its module docstring;
 //! docs/renderers.md, "Blender"): camera, `image`, `ambient`, `render.samples`
 //! and `render.indirect`, point (power 4 pi I W) and directional lights,
 //! `falloff`, `radius`, spheres, planes, quads, boxes, materials (Lambertian
@@ -40,10 +40,11 @@ impl Renderer for Blender {
 
     fn session(
         &self,
-        _base: &Scene,
+        base: &Scene,
         _varying: &ParamSpace,
         jobs: usize,
     ) -> Result<Box<dyn RenderSession>> {
+        super::pbr_fields::check(base, "blender")?;
         let program = discover::find("blender", &discover::apt_hint("blender"))?;
         let cfg = ExecConfig::from_env(jobs, RENDER_TIMEOUT, STARTUP_TIMEOUT)?;
         let dir = run_dir()?;

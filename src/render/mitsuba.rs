@@ -5,7 +5,7 @@
 //! The worker keeps the loaded scene and only updates changed values.
 //!
 //! Scene fields: all of them but `falloff: "none"` (refused: Mitsuba has no
-//! such light), mapped by the worker (its module docstring;
+//! such light) and what `pbr_fields.rs` refuses, mapped by the worker (its module docstring;
 //! docs/renderers.md, "Mitsuba"): camera, `image`, `ambient`,
 //! `render.samples` and `render.indirect`, point lights (W/sr), spheres as
 //! area lights for `radius` > 0, directional lights, spheres, planes,
@@ -49,6 +49,7 @@ impl Renderer for Mitsuba {
         _varying: &ParamSpace,
         jobs: usize,
     ) -> Result<Box<dyn RenderSession>> {
+        super::pbr_fields::check(base, "mitsuba")?;
         check(base)?;
         let python = std::env::var(ENV_PYTHON)
             .ok()

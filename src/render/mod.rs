@@ -12,6 +12,7 @@ pub mod blender;
 pub mod command;
 pub mod external;
 pub mod mitsuba;
+pub mod pbr_fields;
 pub mod pov_sdl;
 pub mod povray;
 

@@ -17,10 +17,14 @@
 //!   the camera (radiosity ignores finish `ambient`).
 //! - lights: `point` -> `light_source` with `fade_distance` FADE_DISTANCE,
 //!   `fade_power 2`, colour I*color / (2 FADE_DISTANCE^2) (`inverse_square`),
-//!   or colour I*color without fade (`none`); `radius` r > 0 -> a circular,
+//!   or colour I*color without fade (`none`); `falloff_power` p: `fade_power`
+//!   p with `fade_distance` 1e-8^(1/p); `radius` r > 0 -> a circular,
 //!   oriented `area_light` of diameter 2r (9x9). `directional` -> a
 //!   `parallel` light 1e6 m away along `direction`, colour E*color.
 //! - objects: `sphere`, `plane`, `quad` (`polygon`), `box`.
+//! - refused (a clear error): a directional light's `radius`, a material's
+//!   `fresnel` (other than 1) and `specular2`. `indirect_light` (the
+//!   built-in tracer's estimate) is not used: `render.indirect` is POV-Ray's.
 //! - material (kd, ks, n, kr, kt, ior; T = min(kt, MAX_TRANSMIT)):
 //!   pigment `rgbt <color, T>`; finish `ambient kd/(1-T)`,
 //!   `diffuse kd/(pi (1-T))` (POV-Ray's diffuse has no 1/pi and is scaled by
@@ -33,8 +37,12 @@ use std::fmt::Write;
 
 /// `fade_distance` of inverse-square lights, metres. POV-Ray's fade is
 /// 2 / (1 + (d/D)^2); with the colour scaled by 1/(2 D^2) that is
-/// 1 / (d^2 + D^2): within D^2/d^2 = 1e-4 of 1/d^2 at 10 cm from the light.
-pub const FADE_DISTANCE: f64 = 1e-3;
+/// 1 / (d^2 + D^2): within D^2/d^2 = 1e-6 of 1/d^2 at 10 cm from the light
+/// (single-precision colours hold the 5e7 scale without loss).
+pub const FADE_DISTANCE: f64 = 1e-4;
+
+/// D^p for any fade power p (see `fade`): 1e-8, so that p = 2 gives D = 0.1 mm.
+const FADE_SCALE: f64 = FADE_DISTANCE * FADE_DISTANCE;
 
 /// The largest transmission POV-Ray can render: its surface shading is
 /// scaled by 1 - transmit, which we undo by dividing; at 1 that is 0/0.
@@ -77,7 +85,45 @@ pub fn check(scene: &Scene) -> Result<(), String> {
             scene.render.max_depth
         ));
     }
+    for l in &scene.lights {
+        if l.kind == LightKind::Directional && l.radius > 0.0 {
+            return Err(format!(
+                "lights.{}.radius: a directional light of angular size is not supported (POV-Ray's parallel lights are points at infinity); use phong",
+                l.name
+            ));
+        }
+    }
+    for o in &scene.objects {
+        let m = &o.material;
+        if m.fresnel.is_some_and(|f| f != 1.0) {
+            return Err(format!(
+                "objects.{}.material.fresnel: not supported (POV-Ray's specular highlight has no Fresnel term); use phong, blender or mitsuba",
+                o.name
+            ));
+        }
+        if m.specular2.is_some_and(|k| k > 0.0) {
+            return Err(format!(
+                "objects.{}.material.specular2: a second specular lobe is not supported by POV-Ray; use phong",
+                o.name
+            ));
+        }
+    }
     Ok(())
+}
+
+/// The fade of a point light whose irradiance falls as 1/d^p: POV-Ray's
+/// `2 / (1 + (d/D)^p)` with D^p = FADE_SCALE, times a colour scale of
+/// 1/(2 FADE_SCALE), is 1/(d^p + FADE_SCALE): within FADE_SCALE/d^p of 1/d^p.
+/// For p = 2, D = 0.1 mm (FADE_DISTANCE). p = 0: no fade.
+fn fade(p: f64) -> (f64, String) {
+    if p <= 0.0 {
+        return (1.0, String::new());
+    }
+    let d = FADE_SCALE.powf(1.0 / p);
+    (
+        1.0 / (2.0 * FADE_SCALE),
+        format!(" fade_distance {} fade_power {}", num(d), num(p)),
+    )
 }
 
 /// The scene file POV-Ray renders.
@@ -195,13 +241,12 @@ fn light(s: &mut String, l: &crate::scene::Light) -> Result<(), String> {
             let p = l
                 .position
                 .ok_or_else(|| format!("lights.{}: a point light needs a position", l.name))?;
-            let (scale, fade) = match l.falloff {
-                Falloff::InverseSquare => (
-                    1.0 / (2.0 * FADE_DISTANCE * FADE_DISTANCE),
-                    format!(" fade_distance {} fade_power 2", num(FADE_DISTANCE)),
-                ),
-                Falloff::None => (1.0, String::new()),
+            let power = match (l.falloff_power, l.falloff) {
+                (Some(p), _) => p,
+                (None, Falloff::InverseSquare) => 2.0,
+                (None, Falloff::None) => 0.0,
             };
+            let (scale, fade) = fade(power);
             let area = if l.radius > 0.0 {
                 let d = num(2.0 * l.radius);
                 format!(" area_light <{d}, 0, 0>, <0, {d}, 0>, 9, 9 circular orient adaptive 1")
@@ -305,12 +350,26 @@ mod tests {
     }
 
     #[test]
+    fn fade_powers() {
+        for p in [1.0f64, 1.5, 2.0, 3.0] {
+            let (scale, text) = fade(p);
+            let dist: f64 = text.split_whitespace().nth(1).unwrap().parse().unwrap();
+            for d in [0.1f64, 1.0, 10.0] {
+                let pov = scale * 2.0 / (1.0 + (d / dist).powf(p));
+                assert!((pov * d.powf(p) - 1.0).abs() <= 1e-4, "p {p} d {d}: {pov}");
+            }
+        }
+        assert_eq!(fade(0.0), (1.0, String::new()));
+        assert!(fade(2.0).1.contains("fade_distance 1e-4 fade_power 2e0"));
+    }
+
+    #[test]
     fn fade_is_inverse_square() {
         // colour * 2 / (1 + (d/D)^2) against 1/d^2
         for d in [0.1f64, 1.0, 10.0] {
             let pov = 1.0 / (2.0 * FADE_DISTANCE * FADE_DISTANCE) * 2.0
                 / (1.0 + (d / FADE_DISTANCE).powi(2));
-            assert!((pov * d * d - 1.0).abs() <= 1e-4, "{d}: {pov}");
+            assert!((pov * d * d - 1.0).abs() <= 1e-6, "{d}: {pov}");
         }
     }
 }
