@@ -10,5 +10,6 @@ pub mod fit;
 pub mod math;
 pub mod metric;
 pub mod optimize;
+pub mod pipeline;
 pub mod render;
 pub mod scene;

@@ -1,0 +1,86 @@
+//! comparison.json, the pipeline's summary (DESIGN.md "Output files"):
+//!
+//! ```json
+//! {"stage1": {"renderer": "phong", "deviation": {"r", "g", "b", "average"},
+//!             "evaluations": 40080, "wall_seconds": 6.1, ...},
+//!  "stage2": {"renderer": "blender", ...},
+//!  "handover": {"seeded": true, "window": 0.15, ...}}
+//! ```
+//!
+//! The DESIGN.md keys come first in each stage; the rest are additions.
+//! `wall_seconds` is the stage's whole wall-clock time, renderer start-up
+//! included; `fit_seconds` is result.json's `wall_seconds`, the time spent
+//! in generations only.
+
+use super::handover::Narrowed;
+use crate::error::{Error, Result};
+use crate::metric::Deviation;
+use serde::{Deserialize, Serialize};
+use std::path::Path;
+
+pub const FILE: &str = "comparison.json";
+
+/// One stage's outcome.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct StageSummary {
+    pub renderer: String,
+    pub deviation: Deviation,
+    pub evaluations: usize,
+    pub wall_seconds: f64,
+    pub fit_seconds: f64,
+    pub generations: usize,
+    pub population: usize,
+    pub strategy: String,
+    pub seed: u64,
+    pub stop_reason: String,
+    /// The stage's run directory, relative to the pipeline directory.
+    pub dir: String,
+}
+
+/// How stage 2 was started from stage 1.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct Handover {
+    /// False with --stage2-from-scratch: full bounds, uniform start.
+    pub seeded: bool,
+    /// Half-width of the stage-2 bounds as a fraction of the original span.
+    pub window: Option<f64>,
+    /// `start_radius` of the stage-2 population (unit cube of its bounds).
+    pub start_radius: Option<f64>,
+    /// The stage-1 fitted values rendered by the stage-2 renderer: how far
+    /// the handover starts from the target before stage 2 moves anything.
+    pub deviation_at_handover: Option<Deviation>,
+    #[serde(default)]
+    pub bounds: Vec<Narrowed>,
+}
+
+/// comparison.json.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct Comparison {
+    pub stage1: StageSummary,
+    pub stage2: StageSummary,
+    pub handover: Handover,
+    /// The target and mask copied into the pipeline directory.
+    pub target: String,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mask: Option<String>,
+}
+
+impl Comparison {
+    pub fn load(dir: &Path) -> Result<Comparison> {
+        let path = dir.join(FILE);
+        let text = std::fs::read_to_string(&path).map_err(|e| Error::io(&path, e))?;
+        serde_json::from_str(&text).map_err(|e| {
+            Error::invalid(
+                path.display().to_string(),
+                "(top level)",
+                format!("not a scenefit pipeline comparison ({e})"),
+            )
+        })
+    }
+
+    pub fn save(&self, dir: &Path) -> Result<()> {
+        let path = dir.join(FILE);
+        let text = serde_json::to_string_pretty(self).map_err(|e| Error::Run(e.to_string()))?;
+        std::fs::write(&path, text).map_err(|e| Error::io(&path, e))
+    }
+}
