@@ -12,4 +12,5 @@ pub mod metric;
 pub mod optimize;
 pub mod pipeline;
 pub mod render;
+pub mod report;
 pub mod scene;

@@ -1,0 +1,155 @@
+//! The HTML report of a run: `report.html` in a fit directory (one stage)
+//! or a pipeline directory (two stages), with its figures beside it as
+//! PNG (shown) and SVG (linked) files, all linked relatively so that the
+//! directory can be moved or zipped whole.
+//!
+//! Figures: target and best renders side by side (upscaled, nearest
+//! neighbour), signed difference heatmaps, the evolution strip (the paper's
+//! Fig. 4), convergence against renders and seconds, and the final
+//! population's light-versus-albedo scatter. Tables: the paper's Table I
+//! (%R %G %B average), the fitted parameters side by side, time and
+//! renders per stage, and the parameter trade-offs.
+
+pub mod data;
+mod figure;
+mod font;
+pub mod heatmap;
+mod html;
+pub mod images;
+mod page;
+pub mod plots;
+pub mod population;
+
+use crate::error::{Error, Result};
+use crate::metric::Mask;
+use crate::pipeline::Comparison;
+use crate::render::{image_io, Image};
+use data::Stage;
+use std::path::{Path, PathBuf};
+
+pub const FILE: &str = "report.html";
+
+/// Where the target and mask are when the run directory does not say.
+#[derive(Clone, Debug, Default)]
+pub struct ReportOptions {
+    pub target: Option<PathBuf>,
+    pub mask: Option<PathBuf>,
+}
+
+/// What a run directory holds, loaded.
+pub struct Run {
+    pub dir: PathBuf,
+    pub stages: Vec<Stage>,
+    pub comparison: Option<Comparison>,
+    /// The target, or why there is none.
+    pub target: std::result::Result<Image, String>,
+    pub mask: Option<Mask>,
+}
+
+/// (Re)writes DIR/report.html and its figures; returns the page's path.
+pub fn write(dir: &Path, options: &ReportOptions) -> Result<PathBuf> {
+    let run = load(dir, options)?;
+    remove_old_figures(dir)?;
+    let html = page::render(&run)?;
+    let path = dir.join(FILE);
+    std::fs::write(&path, html).map_err(|e| Error::io(&path, e))?;
+    Ok(path)
+}
+
+fn load(dir: &Path, options: &ReportOptions) -> Result<Run> {
+    if !dir.is_dir() {
+        return Err(Error::Usage(format!(
+            "{}: not a directory; expected a fit or pipeline run directory",
+            dir.display()
+        )));
+    }
+    let comparison_path = dir.join(crate::pipeline::comparison::FILE);
+    let (stages, comparison) = if comparison_path.is_file() {
+        let c = Comparison::load(dir)?;
+        let s1 = Stage::load(&dir.join(&c.stage1.dir), "Stage 1")?;
+        let s2 = Stage::load(&dir.join(&c.stage2.dir), "Stage 2")?;
+        (vec![s1, s2], Some(c))
+    } else if dir.join("result.json").is_file() {
+        (vec![Stage::load(dir, "Fit")?], None)
+    } else {
+        return Err(Error::Usage(format!(
+            "{}: neither a fit directory (result.json) nor a pipeline directory (comparison.json); has the run finished?",
+            dir.display()
+        )));
+    };
+    let target_path = match (&options.target, &comparison) {
+        (Some(p), _) => Ok(p.clone()),
+        (None, Some(c)) => Ok(dir.join(&c.target)),
+        (None, None) => find_target(dir, &stages[0]),
+    };
+    let best = &stages[0].best;
+    let target = target_path.and_then(|p| {
+        let img = image_io::read_image(&p, "target").map_err(|e| e.to_string())?;
+        if img.dimensions() != best.dimensions() {
+            return Err(format!(
+                "{} is {}x{}, the renders {}x{}",
+                p.display(),
+                img.width(),
+                img.height(),
+                best.width(),
+                best.height()
+            ));
+        }
+        Ok(img)
+    });
+    if let (Some(p), Err(m)) = (&options.target, &target) {
+        return Err(Error::Usage(format!("--target {}: {m}", p.display())));
+    }
+    let mask_path = match (&options.mask, &comparison) {
+        (Some(p), _) => Some(p.clone()),
+        (None, Some(c)) => c.mask.as_ref().map(|m| dir.join(m)),
+        (None, None) => None,
+    };
+    let mask = mask_path
+        .map(|p| Mask::load(&p, best.width(), best.height()))
+        .transpose()?;
+    Ok(Run {
+        dir: dir.to_path_buf(),
+        stages,
+        comparison,
+        target,
+        mask,
+    })
+}
+
+/// Removes the figures of an earlier report, so that none outlives the
+/// data it showed (a figure this run cannot draw is left out, not stale).
+fn remove_old_figures(dir: &Path) -> Result<()> {
+    for e in std::fs::read_dir(dir)
+        .map_err(|e| Error::io(dir, e))?
+        .flatten()
+    {
+        let name = e.file_name().to_string_lossy().to_string();
+        if name.starts_with("fig_") && (name.ends_with(".png") || name.ends_with(".svg")) {
+            let _ = std::fs::remove_file(e.path());
+        }
+    }
+    Ok(())
+}
+
+/// A fit's target, from result.json's `target` (as given on the command
+/// line, so relative to wherever `fit` ran): tried as given, then beside
+/// the run directory.
+fn find_target(dir: &Path, stage: &Stage) -> std::result::Result<PathBuf, String> {
+    let Some(t) = &stage.result.target else {
+        return Err("result.json names no target; pass --target".into());
+    };
+    let given = PathBuf::from(t);
+    let mut tries = vec![given.clone()];
+    if given.is_relative() {
+        if let Some(parent) = dir.parent() {
+            tries.push(parent.join(&given));
+        }
+        if let Some(name) = given.file_name() {
+            tries.push(dir.join(name));
+        }
+    }
+    tries.into_iter().find(|p| p.is_file()).ok_or_else(|| {
+        format!("the target {t} (from result.json) is not found from here; pass --target")
+    })
+}

@@ -1,0 +1,674 @@
+//! The report page, section by section: summary, images, the paper's
+//! Table I, difference heatmaps, fitted parameters, cost, convergence,
+//! evolution strips, parameter trade-offs, files. Each section writes its
+//! figures into the run directory and links them.
+
+use super::data::Stage;
+use super::heatmap::{channel_bias, shared_limit, signed_luminance, Heatmap};
+use super::html::Page;
+use super::images::{evolution_strip, save_upscaled, scale_for};
+use super::plots::{Convergence, Scatter, Series};
+use super::population::{self, Population};
+use super::{figure, Run};
+use crate::error::Result;
+use crate::metric::Deviation;
+use crate::render::image_io;
+use serde_json::Value as Json;
+
+/// The page of a loaded run.
+pub fn render(run: &Run) -> Result<String> {
+    let two = run.stages.len() == 2;
+    let mut page = Page::new(if two {
+        "scenefit report: two-stage fit"
+    } else {
+        "scenefit report: fit"
+    });
+    summary(&mut page, run);
+    images(&mut page, run)?;
+    table_i(&mut page, run);
+    heatmaps(&mut page, run)?;
+    parameters(&mut page, run);
+    cost(&mut page, run);
+    convergence(&mut page, run)?;
+    evolution(&mut page, run)?;
+    trade_offs(&mut page, run)?;
+    files(&mut page, run);
+    Ok(page.finish())
+}
+
+/// "stage1", "stage2" or "fit": the stem of a stage's figure files.
+fn key(run: &Run, i: usize) -> String {
+    match &run.comparison {
+        Some(_) => format!("stage{}", i + 1),
+        None => "fit".into(),
+    }
+}
+
+/// The stage's directory relative to the page ("" or "stage1/").
+fn rel(run: &Run, i: usize) -> String {
+    match &run.comparison {
+        Some(c) => {
+            let d = if i == 0 { &c.stage1.dir } else { &c.stage2.dir };
+            format!("{d}/")
+        }
+        None => String::new(),
+    }
+}
+
+/// Four significant digits, without exponent for everyday magnitudes.
+pub fn num(x: f64) -> String {
+    if !x.is_finite() {
+        return x.to_string();
+    }
+    if x == 0.0 {
+        return "0".into();
+    }
+    let mag = x.abs().log10().floor() as i32;
+    if !(-4..6).contains(&mag) {
+        return format!("{x:.3e}");
+    }
+    let decimals = (3 - mag).clamp(0, 7) as usize;
+    format!("{x:.decimals$}")
+}
+
+fn value(v: &Json) -> String {
+    match v {
+        Json::Number(n) => n.as_f64().map(num).unwrap_or_else(|| n.to_string()),
+        Json::Array(a) => format!("[{}]", a.iter().map(value).collect::<Vec<_>>().join(", ")),
+        other => other.to_string(),
+    }
+}
+
+fn signed(x: f64) -> String {
+    if x >= 0.0 {
+        format!("+{}", num(x))
+    } else {
+        num(x)
+    }
+}
+
+/// The change from `a` to `b`: a difference, and for numbers the relative
+/// change.
+fn change(a: &Json, b: &Json) -> String {
+    match (a, b) {
+        (Json::Number(x), Json::Number(y)) => {
+            let (x, y) = (x.as_f64().unwrap_or(0.0), y.as_f64().unwrap_or(0.0));
+            if x != 0.0 {
+                format!("{} ({:+.1} %)", signed(y - x), 100.0 * (y - x) / x.abs())
+            } else {
+                signed(y - x)
+            }
+        }
+        (Json::Array(x), Json::Array(y)) if x.len() == y.len() => {
+            let d: Vec<String> = x
+                .iter()
+                .zip(y)
+                .map(|(p, q)| signed(q.as_f64().unwrap_or(0.0) - p.as_f64().unwrap_or(0.0)))
+                .collect();
+            format!("[{}]", d.join(", "))
+        }
+        _ => "—".into(),
+    }
+}
+
+fn deviation_row(label: &str, d: &Deviation) -> Vec<String> {
+    vec![
+        label.to_string(),
+        format!("{:.2}", d.r),
+        format!("{:.2}", d.g),
+        format!("{:.2}", d.b),
+        format!("{:.2}", d.average),
+    ]
+}
+
+fn summary(page: &mut Page, run: &Run) {
+    page.p(&format!("Run directory: {}", run.dir.display()));
+    let Some(c) = &run.comparison else {
+        let s = &run.stages[0];
+        page.p(&format!(
+            "One fit with the {} renderer: average deviation {:.2} % after {} renders ({} generations, {:.1} s).",
+            s.result.renderer,
+            s.result.deviation.average,
+            s.result.evaluations,
+            s.result.generations,
+            s.result.wall_seconds
+        ));
+        return;
+    };
+    let (a, b) = (&c.stage1, &c.stage2);
+    let verdict = if b.deviation.average < a.deviation.average {
+        "lower"
+    } else {
+        "not lower"
+    };
+    page.p(&format!(
+        "Stage 1 fitted with {} over the full bounds: {:.2} % average deviation in {} renders ({:.1} s). \
+         Stage 2 refitted with {}: {:.2} % in {} renders ({:.1} s), {verdict} than stage 1.",
+        a.renderer,
+        a.deviation.average,
+        a.evaluations,
+        a.wall_seconds,
+        b.renderer,
+        b.deviation.average,
+        b.evaluations,
+        b.wall_seconds
+    ));
+    let h = &c.handover;
+    if h.seeded {
+        page.p(&format!(
+            "Handover: stage 2 searched the stage-1 values ± {:.0} % of each parameter's original span (clamped to the original bounds), \
+             its population started within radius {} (unit cube of those bounds) of the stage-1 values, which were individual 0.",
+            100.0 * h.window.unwrap_or(0.0),
+            h.start_radius.map(num).unwrap_or_else(|| "—".into())
+        ));
+    } else {
+        page.p("Stage 2 started from scratch: full bounds, uniform initial population (no handover), for comparison with a seeded run.");
+    }
+    if let Some(d) = &h.deviation_at_handover {
+        page.p(&format!(
+            "The stage-1 values rendered by {} deviate {:.2} % from the target: that is where stage 2 started.",
+            b.renderer, d.average
+        ));
+    }
+}
+
+fn images(page: &mut Page, run: &Run) -> Result<()> {
+    page.h2("Target and best renders", "images");
+    let k = scale_for(run.stages[0].best.width());
+    match &run.target {
+        Ok(t) => {
+            let f = save_upscaled(t, k, &run.dir, "fig_target.png")?;
+            page.figure(&f, "Target", true, None);
+        }
+        Err(m) => page.note(&format!("No target shown: {m}")),
+    }
+    for (i, s) in run.stages.iter().enumerate() {
+        let f = save_upscaled(
+            &s.best,
+            k,
+            &run.dir,
+            &format!("fig_{}_best.png", key(run, i)),
+        )?;
+        page.figure(
+            &f,
+            &format!(
+                "{} best: {:.2} % average deviation",
+                s.title(),
+                s.result.deviation.average
+            ),
+            true,
+            None,
+        );
+    }
+    if let Some(c) = &run.comparison {
+        let path = run.dir.join(&c.stage2.dir).join("handover.png");
+        if let (Ok(img), Some(d)) = (
+            image_io::read_image(&path, "handover.png"),
+            &c.handover.deviation_at_handover,
+        ) {
+            let f = save_upscaled(&img, k, &run.dir, "fig_handover.png")?;
+            page.figure(
+                &f,
+                &format!(
+                    "Stage-1 values rendered by {} (the handover): {:.2} %",
+                    c.stage2.renderer, d.average
+                ),
+                true,
+                None,
+            );
+        }
+    }
+    page.note(&format!(
+        "Renders shown {k}x their size, nearest neighbour (each square is one pixel)."
+    ));
+    Ok(())
+}
+
+fn table_i(page: &mut Page, run: &Run) {
+    page.h2("Deviation (the paper's Table I format)", "deviation");
+    let mut rows: Vec<Vec<String>> = run
+        .stages
+        .iter()
+        .map(|s| deviation_row(&s.title(), &s.result.deviation))
+        .collect();
+    if let Some(c) = &run.comparison {
+        if let Some(d) = &c.handover.deviation_at_handover {
+            rows.push(deviation_row(
+                &format!("Stage-1 values rendered by {}", c.stage2.renderer),
+                d,
+            ));
+        }
+    }
+    page.table(&["", "%R", "%G", "%B", "Average"], &rows);
+    page.note("Deviation per channel: 100 · mean |target − render| / 255 over the mask (all pixels without one), on 8-bit sRGB values.");
+    if let Ok(t) = &run.target {
+        let rows: Vec<Vec<String>> = run
+            .stages
+            .iter()
+            .map(|s| {
+                let b = channel_bias(t, &s.best, run.mask.as_ref());
+                vec![s.title(), signed(b[0]), signed(b[1]), signed(b[2])]
+            })
+            .collect();
+        page.table(&["Mean target − render (8-bit)", "R", "G", "B"], &rows);
+        page.note("Positive: the render is darker than the target in that channel on average.");
+    }
+}
+
+fn heatmaps(page: &mut Page, run: &Run) -> Result<()> {
+    page.h2("Where the renders differ from the target", "differences");
+    let Ok(t) = &run.target else {
+        page.note("No target, so no difference maps.");
+        return Ok(());
+    };
+    let diffs: Vec<Vec<Option<f64>>> = run
+        .stages
+        .iter()
+        .map(|s| signed_luminance(t, &s.best, run.mask.as_ref()))
+        .collect();
+    let limit = shared_limit(&diffs.iter().map(|d| d.as_slice()).collect::<Vec<_>>());
+    let k = scale_for(t.width());
+    for (i, (s, diff)) in run.stages.iter().zip(diffs).enumerate() {
+        let map = Heatmap {
+            title: format!("Target − {}", s.title()),
+            diff,
+            width: t.width(),
+            height: t.height(),
+            k,
+            limit,
+        };
+        let (png, svg) = figure::save(&map, &run.dir, &format!("fig_diff_{}", key(run, i)))?;
+        page.figure(
+            &png,
+            &format!("Signed luminance difference, target − {} best", s.title()),
+            false,
+            Some(&svg),
+        );
+    }
+    page.note(&format!(
+        "One scale for all maps, ±{limit:.0} levels (99 % of pixels fall inside); grey: outside the mask."
+    ));
+    Ok(())
+}
+
+fn parameters(page: &mut Page, run: &Run) {
+    page.h2("Fitted parameters", "parameters");
+    let first = &run.stages[0].result.params;
+    if run.stages.len() == 1 {
+        let rows: Vec<Vec<String>> = first
+            .iter()
+            .map(|(k, v)| vec![k.clone(), value(v)])
+            .collect();
+        page.table(&["Parameter", "Fitted"], &rows);
+    } else {
+        let second = &run.stages[1].result.params;
+        let mut names: Vec<&String> = first.keys().collect();
+        names.extend(second.keys().filter(|k| !first.contains_key(*k)));
+        let rows: Vec<Vec<String>> = names
+            .iter()
+            .map(|k| {
+                let (a, b) = (first.get(*k), second.get(*k));
+                vec![
+                    (*k).clone(),
+                    a.map(value).unwrap_or_else(|| "—".into()),
+                    b.map(value).unwrap_or_else(|| "—".into()),
+                    match (a, b) {
+                        (Some(a), Some(b)) => change(a, b),
+                        _ => "—".into(),
+                    },
+                ]
+            })
+            .collect();
+        let h1 = run.stages[0].title();
+        let h2 = run.stages[1].title();
+        page.table(&["Parameter", &h1, &h2, "Change"], &rows);
+    }
+    page.note("Scene units: colours as linear RGB whatever space they were searched in; light intensity in W/sr. Every backend reads these same values and converts them itself (docs/renderers.md).");
+}
+
+fn cost(page: &mut Page, run: &Run) {
+    page.h2("Time and renders", "cost");
+    let rows: Vec<Vec<String>> = run
+        .stages
+        .iter()
+        .enumerate()
+        .map(|(i, s)| {
+            let r = &s.result;
+            let wall = match &run.comparison {
+                Some(c) if i == 0 => c.stage1.wall_seconds,
+                Some(c) => c.stage2.wall_seconds,
+                None => r.wall_seconds,
+            };
+            vec![
+                s.title(),
+                r.evaluations.to_string(),
+                r.generations.to_string(),
+                format!("{wall:.1}"),
+                format!("{:.1}", r.wall_seconds),
+                format!("{:.0}", r.evaluations as f64 / r.wall_seconds.max(1e-9)),
+                r.failed_renders.to_string(),
+                r.stop_reason.clone(),
+            ]
+        })
+        .collect();
+    page.table(
+        &[
+            "",
+            "Renders",
+            "Generations",
+            "Wall s",
+            "In generations s",
+            "Renders/s",
+            "Failed",
+            "Stopped by",
+        ],
+        &rows,
+    );
+    page.note(if run.comparison.is_some() {
+        "Wall s: the whole stage, renderer start-up included; in generations s: result.json's wall_seconds, rendering and comparing only."
+    } else {
+        "Seconds: result.json's wall_seconds, the time spent in generations (renderer start-up not included)."
+    });
+}
+
+fn convergence(page: &mut Page, run: &Run) -> Result<()> {
+    page.h2("Convergence", "convergence");
+    let series = |f: &dyn Fn(&super::data::CurvePoint) -> f64| -> Vec<Series> {
+        run.stages
+            .iter()
+            .map(|s| Series {
+                label: s.title(),
+                points: s
+                    .curve
+                    .iter()
+                    .map(|p| (f(p), p.deviation.average))
+                    .collect(),
+            })
+            .collect()
+    };
+    let references: Vec<(String, f64)> = match run.stages.as_slice() {
+        [s1, _] => vec![(format!("{} final", s1.title()), s1.result.deviation.average)],
+        _ => Vec::new(),
+    };
+    let by_renders = Convergence {
+        title: "Best deviation against renders".into(),
+        x_label: "renders (within the stage)".into(),
+        series: series(&|p| p.evaluations as f64),
+        references: references.clone(),
+    };
+    let (png, svg) = figure::save(&by_renders, &run.dir, "fig_convergence_renders")?;
+    page.figure(
+        &png,
+        "Deviation against renders, log-log",
+        false,
+        Some(&svg),
+    );
+    let by_seconds = Convergence {
+        title: "Best deviation against seconds".into(),
+        x_label: "seconds in generations (within the stage)".into(),
+        series: series(&|p| p.seconds),
+        references,
+    };
+    let (png, svg) = figure::save(&by_seconds, &run.dir, "fig_convergence_seconds")?;
+    page.figure(
+        &png,
+        "Deviation against seconds, log-log",
+        false,
+        Some(&svg),
+    );
+    for s in &run.stages {
+        if !s.seconds_measured {
+            page.note(&format!(
+                "{}: no trace.tsv, so the curve is progress.txt's (every 10 generations) and its seconds assume every generation took the same time (wall_seconds / generations).",
+                s.title()
+            ));
+        }
+    }
+    Ok(())
+}
+
+fn evolution(page: &mut Page, run: &Run) -> Result<()> {
+    page.h2("Evolution (the paper's Fig. 4)", "evolution");
+    for (i, s) in run.stages.iter().enumerate() {
+        let name = format!("fig_evolution_{}.png", key(run, i));
+        match evolution_strip(&s.dir, &s.snapshots, &run.dir, &name)? {
+            Some(f) => page.figure(
+                &f,
+                &format!(
+                    "{}: the best image every 10 generations (best_gNNNN.bmp)",
+                    s.title()
+                ),
+                true,
+                None,
+            ),
+            None => page.note(&format!("{}: no best_gNNNN.bmp snapshots.", s.title())),
+        }
+    }
+    Ok(())
+}
+
+fn trade_offs(page: &mut Page, run: &Run) -> Result<()> {
+    page.h2("What the image does not determine", "trade-offs");
+    page.p("A converged population spreads along the directions in which the deviation barely changes. \
+            Light intensity and albedo are the classic pair: a diffuse surface shows their product, \
+            so the population spreads along I · ρ = const (negative correlation) while the product stays put.");
+    for (i, s) in run.stages.iter().enumerate() {
+        match population::load(&s.dir) {
+            Ok(p) => population_section(page, run, i, s, &p)?,
+            Err(why) => page.note(&format!(
+                "{}: no final population ({why}). A fit run by `scenefit pipeline` keeps it in final_checkpoint.json.",
+                s.title()
+            )),
+        }
+    }
+    Ok(())
+}
+
+fn opt_pct(x: Option<f64>) -> String {
+    x.map(|v| format!("{:.1} %", 100.0 * v))
+        .unwrap_or_else(|| "—".into())
+}
+
+fn population_section(
+    page: &mut Page,
+    run: &Run,
+    i: usize,
+    s: &Stage,
+    p: &Population,
+) -> Result<()> {
+    page.raw(&format!(
+        "<h3>{}: final population ({} individuals, phase {}, from {})</h3>",
+        super::html::esc(&s.title()),
+        p.rows.len(),
+        p.phase,
+        super::html::esc(&p.file)
+    ));
+    let rows: Vec<Vec<String>> = p
+        .spreads()
+        .into_iter()
+        .map(|sp| {
+            vec![
+                sp.name.clone(),
+                num(sp.mean),
+                num(sp.std),
+                opt_pct(sp.relative()),
+                num(sp.min),
+                num(sp.max),
+            ]
+        })
+        .collect();
+    page.table(
+        &["Parameter", "Mean", "Std", "Std / |mean|", "Min", "Max"],
+        &rows,
+    );
+    let trades = p.trade_offs();
+    if trades.is_empty() {
+        page.note("No light intensity or colour is free together with an albedo-type parameter (colour, diffuse, specular), so there is no intensity–albedo trade-off to show.");
+    } else {
+        let rows: Vec<Vec<String>> = trades
+            .iter()
+            .map(|t| {
+                vec![
+                    t.light.clone(),
+                    t.albedo.clone(),
+                    t.correlation
+                        .map(|r| format!("{r:+.2}"))
+                        .unwrap_or_else(|| "—".into()),
+                    opt_pct(t.relative_spread[0]),
+                    opt_pct(t.relative_spread[1]),
+                    opt_pct(t.relative_spread[2]),
+                ]
+            })
+            .collect();
+        page.table(
+            &[
+                "Light",
+                "Albedo",
+                "Correlation",
+                "Spread light",
+                "Spread albedo",
+                "Spread product",
+            ],
+            &rows,
+        );
+        for t in &trades {
+            if let (Some(r), [Some(a), Some(b), Some(prod)]) = (t.correlation, t.relative_spread) {
+                if r < -0.5 && prod < 0.5 * a.min(b) {
+                    page.p(&format!(
+                        "{} and {} trade off (correlation {r:+.2}): their product varies {:.1} % over the population, each alone {:.1} % and {:.1} %. \
+                         The image fixes the product; their split rests on the bounds and the rest of the scene.",
+                        t.light, t.albedo, 100.0 * prod, 100.0 * a, 100.0 * b
+                    ));
+                }
+            }
+        }
+        // The scatter of the strongest pair.
+        let strongest = trades
+            .iter()
+            .filter(|t| t.correlation.is_some())
+            .max_by(|a, b| {
+                a.correlation
+                    .unwrap_or(0.0)
+                    .abs()
+                    .total_cmp(&b.correlation.unwrap_or(0.0).abs())
+            });
+        if let Some(t) = strongest {
+            if let Some(points) = p.pairs(&t.light, &t.albedo) {
+                let scatter = Scatter {
+                    title: format!("{}: final population", s.title()),
+                    x_label: t.light.clone(),
+                    y_label: t.albedo.clone(),
+                    points,
+                };
+                let (png, svg) = figure::save(
+                    &scatter,
+                    &run.dir,
+                    &format!("fig_population_{}", key(run, i)),
+                )?;
+                page.figure(
+                    &png,
+                    &format!(
+                        "{} against {} over the final population (darker: lower deviation)",
+                        t.albedo, t.light
+                    ),
+                    false,
+                    Some(&svg),
+                );
+            }
+        }
+    }
+    let strong = p.strong_pairs(0.7);
+    if !strong.is_empty() {
+        let rows: Vec<Vec<String>> = strong
+            .iter()
+            .take(12)
+            .map(|(a, b, r)| vec![a.clone(), b.clone(), format!("{r:+.2}")])
+            .collect();
+        page.table(
+            &["Parameter", "Parameter", "Correlation (|r| ≥ 0.7)"],
+            &rows,
+        );
+    }
+    Ok(())
+}
+
+fn files(page: &mut Page, run: &Run) {
+    page.h2("Files", "files");
+    let mut list: Vec<(String, String)> = Vec::new();
+    let mut add = |path: String, what: &str| {
+        if run.dir.join(&path).is_file() {
+            list.push((path, what.to_string()));
+        }
+    };
+    add(
+        "comparison.json".into(),
+        "both stages' deviation, renders and seconds",
+    );
+    add(
+        "target.png".into(),
+        "the target both stages were compared with",
+    );
+    add("mask.png".into(), "the mask (white: pixels that count)");
+    for i in 0..run.stages.len() {
+        let r = rel(run, i);
+        add(
+            format!("{r}input_scene.json"),
+            "the scene stage 2 searched (narrowed bounds)",
+        );
+        add(
+            format!("{r}result.json"),
+            "fitted values, deviation, renders, seconds",
+        );
+        add(
+            format!("{r}fitted_scene.json"),
+            "the scene with the fitted values",
+        );
+        add(format!("{r}best.png"), "the best render, full size");
+        add(
+            format!("{r}progress.txt"),
+            "best deviation and parameters every 10 generations",
+        );
+        add(
+            format!("{r}trace.tsv"),
+            "best deviation and seconds every generation",
+        );
+    }
+    for stem in [
+        "fig_diff_stage1",
+        "fig_diff_stage2",
+        "fig_diff_fit",
+        "fig_convergence_renders",
+        "fig_convergence_seconds",
+        "fig_population_stage1",
+        "fig_population_stage2",
+        "fig_population_fit",
+    ] {
+        add(format!("{stem}.svg"), "figure, vector");
+    }
+    page.links(&list);
+    page.note("Regenerate this page with: scenefit report DIR. Render a fitted scene large with: scenefit render fitted_scene.json --renderer blender --width 1280 --height 960 -o big.png");
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn numbers_and_changes() {
+        assert_eq!(num(12.3456), "12.35");
+        assert_eq!(num(0.012345), "0.01235");
+        assert_eq!(num(1234.5), "1234");
+        assert_eq!(num(1.5e7), "1.500e7");
+        assert_eq!(
+            change(&serde_json::json!(10.0), &serde_json::json!(12.0)),
+            "+2.000 (+20.0 %)"
+        );
+        assert_eq!(
+            change(
+                &serde_json::json!([1.0, 2.0]),
+                &serde_json::json!([1.5, 1.0])
+            ),
+            "[+0.5000, -1.000]"
+        );
+    }
+}
