@@ -5,8 +5,10 @@
 mod demo;
 mod diagnose;
 mod fit;
+mod pipeline;
 mod progress;
 mod render;
+mod report;
 
 use clap::{Parser, Subcommand};
 
@@ -29,6 +31,10 @@ enum Command {
     Render(render::RenderArgs),
     /// Fit a scene's free parameters to a target image.
     Fit(fit::FitArgs),
+    /// Two-stage fit: Phong over the full bounds, then a physically based renderer around its result.
+    Pipeline(pipeline::PipelineArgs),
+    /// (Re)write report.html of a fit or pipeline directory.
+    Report(report::ReportArgs),
     /// Find the effect a fit's model lacks, add it, refit, report before and after.
     Diagnose(diagnose::DiagnoseArgs),
 }
@@ -53,6 +59,8 @@ pub fn main() -> i32 {
         Command::Demo(a) => demo::run(a),
         Command::Render(a) => render::run(a),
         Command::Fit(a) => fit::run(a),
+        Command::Pipeline(a) => pipeline::run(a),
+        Command::Report(a) => report::run(a),
         Command::Diagnose(a) => diagnose::run(a),
     };
     match result {
