@@ -412,3 +412,56 @@ fn generation_that_fails_entirely_stops_the_run_and_resume_continues() {
         .expect("intensity");
     assert!((intensity - 10.0).abs() < 1.0, "{intensity}");
 }
+
+/// The commands of docs/plugins.md, as written there (output paths in a
+/// temporary directory).
+#[test]
+fn documented_plugin_example_works() {
+    if !have_python() {
+        return;
+    }
+    let dir = tempdir();
+    let d = dir.path();
+    let target = d.join("ball-target.png").display().to_string();
+    let out = d.join("ball-fit").display().to_string();
+    let root = root();
+    let o = run(
+        &root,
+        &[
+            "render",
+            "examples/plugins/ball.json",
+            "-o",
+            &target,
+            "--renderer",
+            "cmd:python3 examples/plugins/lambert.py {scene} {output}",
+            "--set",
+            "lights.key.intensity=10",
+            "--set",
+            "objects.floor.material.diffuse=0.6",
+        ],
+        &[],
+    );
+    expect_code(&o, 0);
+    let o = run(
+        &root,
+        &[
+            "fit",
+            "examples/plugins/ball.json",
+            "--target",
+            &target,
+            "-o",
+            &out,
+            "--renderer",
+            "worker:python3 examples/plugins/lambert.py --worker",
+            "--population",
+            "10",
+            "--generations",
+            "15",
+        ],
+        &[],
+    );
+    expect_code(&o, 0);
+    let r = result(std::path::Path::new(&out));
+    let dev = r["deviation"]["average"].as_f64().expect("deviation");
+    assert!(dev < 0.5, "deviation {dev}");
+}

@@ -20,6 +20,7 @@ specular, reflection and transmission (a Lambertian renderer).
 
 import json
 import math
+import os
 import struct
 import sys
 import zlib
@@ -91,8 +92,11 @@ def write_png(path, w, h, rows):
 
     png = b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, 8, 2, 0, 0, 0))
     png += chunk(b"IDAT", zlib.compress(raw, 1)) + chunk(b"IEND", b"")
-    with open(path, "wb") as f:
+    # a temporary name, then a rename: scenefit never reads half a file
+    tmp = "%s.tmp%d" % (path, os.getpid())
+    with open(tmp, "wb") as f:
         f.write(png)
+    os.replace(tmp, path)
 
 
 def render(scene, out):
