@@ -465,3 +465,67 @@ fn documented_plugin_example_works() {
     let dev = r["deviation"]["average"].as_f64().expect("deviation");
     assert!(dev < 0.5, "deviation {dev}");
 }
+
+/// True while process `pid` exists (and is not a zombie).
+fn alive(pid: u32) -> bool {
+    std::fs::read_to_string(format!("/proc/{pid}/stat"))
+        .is_ok_and(|s| !s.split_whitespace().nth(2).is_some_and(|st| st == "Z"))
+}
+
+#[test]
+fn workers_are_killed_when_the_session_ends() {
+    if !have_python() {
+        return;
+    }
+    let _env = ENV.lock().unwrap_or_else(|p| p.into_inner());
+    let pids = tempdir();
+    std::env::set_var("FAULTY_PIDDIR", pids.path());
+    let base = scene(&small_scene());
+    let r = from_spec(&format!("worker:python3 {} --worker --fault ok", faulty())).unwrap();
+    let mut session = r
+        .session(&base, &ParamSpace::default(), 3)
+        .expect("session starts");
+    std::env::remove_var("FAULTY_PIDDIR");
+    assert!(session
+        .render_batch(&[base.clone(), base.clone()], 0)
+        .iter()
+        .all(|x| x.is_ok()));
+    let started: Vec<u32> = std::fs::read_dir(pids.path())
+        .unwrap()
+        .filter_map(|e| e.ok()?.file_name().to_str()?.parse().ok())
+        .collect();
+    assert_eq!(started.len(), 3);
+    assert!(started.iter().all(|p| alive(*p)));
+    drop(session);
+    for p in &started {
+        assert!(!alive(*p), "worker {p} outlived its session");
+    }
+}
+
+#[test]
+fn a_timeout_kills_what_the_renderer_started() {
+    if !have("sh", "sh") {
+        return;
+    }
+    let _env = ENV.lock().unwrap_or_else(|p| p.into_inner());
+    let dir = tempdir();
+    let pidfile = dir.path().join("child.pid");
+    // a wrapper that starts a long-running child and waits for it
+    let template = format!(
+        "cmd:sh -c 'sleep 300 & echo $! > {}; wait' {{scene}} {{output}}",
+        pidfile.display()
+    );
+    std::env::set_var("SCENEFIT_RENDER_TIMEOUT", "1");
+    let r = render_mix(&template, 1, 1);
+    std::env::remove_var("SCENEFIT_RENDER_TIMEOUT");
+    assert!(failure(&r[0]).contains("timed out after 1 s"));
+    let pid: u32 = std::fs::read_to_string(&pidfile)
+        .expect("the wrapper wrote its child's pid")
+        .trim()
+        .parse()
+        .expect("a pid");
+    assert!(
+        !alive(pid),
+        "the wrapper's child {pid} survived the timeout"
+    );
+}

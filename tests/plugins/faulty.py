@@ -5,7 +5,8 @@ Renders that do not fail are made by examples/plugins/lambert.py.
 One-shot:   faulty.py --fault MODE SCENE OUT
 Persistent: faulty.py --worker --fault MODE [--after N]
 
-MODE (env FAULTY_MODE overrides it when set):
+MODE (env FAULTY_MODE overrides it when set; a worker started with env
+FAULTY_PIDDIR set leaves an empty file named after its pid there):
   ok         render normally
   crash      one-shot: exit 3; worker: exit 3 while serving the request
   hang       sleep for an hour
@@ -81,6 +82,9 @@ def one_shot(mode, scene_path, out):
 
 def worker(mode, after):
     renderer = lambert()
+    piddir = os.environ.get("FAULTY_PIDDIR")
+    if piddir:
+        open(os.path.join(piddir, str(os.getpid())), "w").close()
     if mode == "nostart":
         sys.stderr.write("faulty.py: refusing to start\n")
         return 4
