@@ -9,7 +9,9 @@
 //! `--direct` sets `render.indirect` false. Renders/s counts the fit's
 //! evaluations over its wall time (worker start-up excluded, as the fit
 //! reports it); "outside" is 1 - (time renderers were busy) / (slots x
-//! wall time), slots = min(jobs, population).
+//! wall time), slots = min(jobs, population). CPU per render splits the
+//! CPU time into scenefit's own and its renderer processes' (workers are
+//! counted once they exit, at the end of the fit).
 
 use scenefit::exec::stats;
 use scenefit::fit::{self, FitConfig, FitTarget};
@@ -55,6 +57,7 @@ fn main() {
         ..FitConfig::default()
     };
     stats::reset();
+    let cpu_before = cpu_seconds();
     let started = std::time::Instant::now();
     let result = fit::run(
         &scene,
@@ -70,6 +73,8 @@ fn main() {
     )
     .unwrap_or_else(|e| fail(&e.to_string()));
     let total = started.elapsed().as_secs_f64();
+    let cpu_after = cpu_seconds();
+    let (own, children) = (cpu_after.0 - cpu_before.0, cpu_after.1 - cpu_before.1);
     let (attempts, busy) = stats::snapshot();
     let wall = result.wall_seconds;
     let slots = jobs.min(population) as f64;
@@ -77,14 +82,34 @@ fn main() {
     println!(
         "{renderer_name}: jobs {jobs}, population {population}, {} renders in {wall:.2} s = {:.1} renders/s; \
          renderer busy {:.1} % of {slots} slots, outside {:.1} %; {attempts} attempts, {} failed; \
-         run incl. start-up {total:.2} s; deviation {:.3} %",
+         run incl. start-up {total:.2} s; deviation {:.3} %; \
+         CPU per render: scenefit {:.1} ms, renderer processes {:.1} ms ({:.1} % in scenefit)",
         result.evaluations,
         result.evaluations as f64 / wall,
         100.0 * (1.0 - outside),
         100.0 * outside,
         result.failed_renders,
-        result.deviation.average
+        result.deviation.average,
+        1e3 * own / result.evaluations as f64,
+        1e3 * children / result.evaluations as f64,
+        100.0 * own / (own + children).max(1e-12)
     );
+}
+
+/// CPU seconds of this process and of its waited-for children
+/// (/proc/self/stat utime + stime, cutime + cstime).
+fn cpu_seconds() -> (f64, f64) {
+    let stat = std::fs::read_to_string("/proc/self/stat").unwrap_or_default();
+    // fields after the command name, which ends with ')'
+    let rest = stat.rsplit(')').next().unwrap_or("");
+    let f: Vec<f64> = rest
+        .split_whitespace()
+        .map(|x| x.parse().unwrap_or(0.0))
+        .collect();
+    let tick = 100.0; // USER_HZ on Linux
+    let get = |i: usize| f.get(i).copied().unwrap_or(0.0) / tick;
+    // utime, stime, cutime, cstime are fields 14-17; `rest` starts at field 3
+    (get(11) + get(12), get(13) + get(14))
 }
 
 fn fail(msg: &str) -> ! {
