@@ -19,6 +19,7 @@ pub mod images;
 mod page;
 pub mod plots;
 pub mod population;
+mod tradeoffs;
 
 use crate::error::{Error, Result};
 use crate::metric::Mask;

@@ -3,12 +3,10 @@
 //! evolution strips, parameter trade-offs, files. Each section writes its
 //! figures into the run directory and links them.
 
-use super::data::Stage;
 use super::heatmap::{channel_bias, shared_limit, signed_luminance, Heatmap};
 use super::html::Page;
 use super::images::{evolution_strip, save_upscaled, scale_for};
-use super::plots::{Convergence, Scatter, Series};
-use super::population::{self, Population};
+use super::plots::{Convergence, Series};
 use super::{figure, Run};
 use crate::error::Result;
 use crate::metric::Deviation;
@@ -31,13 +29,13 @@ pub fn render(run: &Run) -> Result<String> {
     cost(&mut page, run);
     convergence(&mut page, run)?;
     evolution(&mut page, run)?;
-    trade_offs(&mut page, run)?;
+    super::tradeoffs::section(&mut page, run)?;
     files(&mut page, run);
     Ok(page.finish())
 }
 
 /// "stage1", "stage2" or "fit": the stem of a stage's figure files.
-fn key(run: &Run, i: usize) -> String {
+pub(super) fn key(run: &Run, i: usize) -> String {
     match &run.comparison {
         Some(_) => format!("stage{}", i + 1),
         None => "fit".into(),
@@ -443,151 +441,6 @@ fn evolution(page: &mut Page, run: &Run) -> Result<()> {
             ),
             None => page.note(&format!("{}: no best_gNNNN.bmp snapshots.", s.title())),
         }
-    }
-    Ok(())
-}
-
-fn trade_offs(page: &mut Page, run: &Run) -> Result<()> {
-    page.h2("What the image does not determine", "trade-offs");
-    page.p("A converged population spreads along the directions in which the deviation barely changes. \
-            Light intensity and albedo are the classic pair: a diffuse surface shows their product, \
-            so the population spreads along I · ρ = const (negative correlation) while the product stays put.");
-    for (i, s) in run.stages.iter().enumerate() {
-        match population::load(&s.dir) {
-            Ok(p) => population_section(page, run, i, s, &p)?,
-            Err(why) => page.note(&format!(
-                "{}: no final population ({why}). A fit run by `scenefit pipeline` keeps it in final_checkpoint.json.",
-                s.title()
-            )),
-        }
-    }
-    Ok(())
-}
-
-fn opt_pct(x: Option<f64>) -> String {
-    x.map(|v| format!("{:.1} %", 100.0 * v))
-        .unwrap_or_else(|| "—".into())
-}
-
-fn population_section(
-    page: &mut Page,
-    run: &Run,
-    i: usize,
-    s: &Stage,
-    p: &Population,
-) -> Result<()> {
-    page.raw(&format!(
-        "<h3>{}: final population ({} individuals, phase {}, from {})</h3>",
-        super::html::esc(&s.title()),
-        p.rows.len(),
-        p.phase,
-        super::html::esc(&p.file)
-    ));
-    let rows: Vec<Vec<String>> = p
-        .spreads()
-        .into_iter()
-        .map(|sp| {
-            vec![
-                sp.name.clone(),
-                num(sp.mean),
-                num(sp.std),
-                opt_pct(sp.relative()),
-                num(sp.min),
-                num(sp.max),
-            ]
-        })
-        .collect();
-    page.table(
-        &["Parameter", "Mean", "Std", "Std / |mean|", "Min", "Max"],
-        &rows,
-    );
-    let trades = p.trade_offs();
-    if trades.is_empty() {
-        page.note("No light intensity or colour is free together with an albedo-type parameter (colour, diffuse, specular), so there is no intensity–albedo trade-off to show.");
-    } else {
-        let rows: Vec<Vec<String>> = trades
-            .iter()
-            .map(|t| {
-                vec![
-                    t.light.clone(),
-                    t.albedo.clone(),
-                    t.correlation
-                        .map(|r| format!("{r:+.2}"))
-                        .unwrap_or_else(|| "—".into()),
-                    opt_pct(t.relative_spread[0]),
-                    opt_pct(t.relative_spread[1]),
-                    opt_pct(t.relative_spread[2]),
-                ]
-            })
-            .collect();
-        page.table(
-            &[
-                "Light",
-                "Albedo",
-                "Correlation",
-                "Spread light",
-                "Spread albedo",
-                "Spread product",
-            ],
-            &rows,
-        );
-        for t in &trades {
-            if let (Some(r), [Some(a), Some(b), Some(prod)]) = (t.correlation, t.relative_spread) {
-                if r < -0.5 && prod < 0.5 * a.min(b) {
-                    page.p(&format!(
-                        "{} and {} trade off (correlation {r:+.2}): their product varies {:.1} % over the population, each alone {:.1} % and {:.1} %. \
-                         The image fixes the product; their split rests on the bounds and the rest of the scene.",
-                        t.light, t.albedo, 100.0 * prod, 100.0 * a, 100.0 * b
-                    ));
-                }
-            }
-        }
-        // The scatter of the strongest pair.
-        let strongest = trades
-            .iter()
-            .filter(|t| t.correlation.is_some())
-            .max_by(|a, b| {
-                a.correlation
-                    .unwrap_or(0.0)
-                    .abs()
-                    .total_cmp(&b.correlation.unwrap_or(0.0).abs())
-            });
-        if let Some(t) = strongest {
-            if let Some(points) = p.pairs(&t.light, &t.albedo) {
-                let scatter = Scatter {
-                    title: format!("{}: final population", s.title()),
-                    x_label: t.light.clone(),
-                    y_label: t.albedo.clone(),
-                    points,
-                };
-                let (png, svg) = figure::save(
-                    &scatter,
-                    &run.dir,
-                    &format!("fig_population_{}", key(run, i)),
-                )?;
-                page.figure(
-                    &png,
-                    &format!(
-                        "{} against {} over the final population (darker: lower deviation)",
-                        t.albedo, t.light
-                    ),
-                    false,
-                    Some(&svg),
-                );
-            }
-        }
-    }
-    let strong = p.strong_pairs(0.7);
-    if !strong.is_empty() {
-        let rows: Vec<Vec<String>> = strong
-            .iter()
-            .take(12)
-            .map(|(a, b, r)| vec![a.clone(), b.clone(), format!("{r:+.2}")])
-            .collect();
-        page.table(
-            &["Parameter", "Parameter", "Correlation (|r| ≥ 0.7)"],
-            &rows,
-        );
     }
     Ok(())
 }
