@@ -26,7 +26,7 @@ pub struct DiagnoseArgs {
     #[arg(long, default_value_t = 16)]
     population: usize,
     /// Generations of each refit (searching the effect, then refining all).
-    #[arg(long, default_value_t = 65)]
+    #[arg(long, default_value_t = 80)]
     generations: usize,
     /// Effects accepted at most.
     #[arg(long, default_value_t = 3)]
@@ -51,8 +51,8 @@ pub fn run(a: DiagnoseArgs) -> Result<()> {
     let mut config = DiagnoseConfig {
         renderer: a.renderer,
         population: a.population,
-        search_generations: (a.generations * 2 / 5).max(1),
-        refine_generations: (a.generations - (a.generations * 2 / 5).max(1)).max(1),
+        search_generations: a.generations / 2,
+        refine_generations: a.generations - a.generations / 2,
         max_rounds: a.max_effects,
         seed: a.seed,
         ..DiagnoseConfig::default()

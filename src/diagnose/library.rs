@@ -172,7 +172,7 @@ pub fn extend(scene: &Scene, effect: &str) -> Option<Extension> {
                 return None;
             }
             s.indirect_light = Some(0.0);
-            added.push(scalar("indirect_light", 0.0, 4.0));
+            added.push(scalar("indirect_light", 0.0, 8.0));
         }
         "fresnel" => {
             let names = glossy(scene);

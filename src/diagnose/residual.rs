@@ -219,6 +219,8 @@ pub fn blur(src: &[f64], w: usize, h: usize, r: usize) -> Vec<f64> {
 
 /// R² of y on the maps (plus an intercept) over `pixels`, by the normal
 /// equations (a handful of features: Gaussian elimination suffices).
+// Indices read as the algebra (normal equations, elimination).
+#[allow(clippy::needless_range_loop)]
 fn r_squared(y: &[f64], maps: &[Vec<f64>], pixels: &[usize]) -> f64 {
     let k = maps.len() + 1;
     let n = pixels.len() as f64;
@@ -258,6 +260,7 @@ fn r_squared(y: &[f64], maps: &[Vec<f64>], pixels: &[usize]) -> f64 {
     (1.0 - rss / tss).clamp(0.0, 1.0)
 }
 
+#[allow(clippy::needless_range_loop)]
 fn solve(mut a: Vec<Vec<f64>>) -> Option<Vec<f64>> {
     let k = a.len();
     for c in 0..k {

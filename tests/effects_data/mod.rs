@@ -1,0 +1,176 @@
+//! Test data with undeclared effects: targets rendered with one effect the
+//! fitting model does not declare, for every effect DESIGN.md names, over
+//! scene variants, strengths, seeds and noise levels; and the fit of each
+//! with the model that lacks the effect.
+
+#![allow(dead_code)]
+
+use rand::{Rng, SeedableRng};
+use scenefit::fit::{self, FitConfig, FitTarget};
+use scenefit::optimize::DeConfig;
+use scenefit::render::{from_spec, render_one, Image};
+use scenefit::scene::{Light, LightKind, Response, Scene, Vignetting};
+use std::path::Path;
+
+pub const EFFECTS: [&str; 9] = [
+    "ambient",
+    "light_falloff",
+    "second_light",
+    "area_light",
+    "vignetting",
+    "camera_response",
+    "indirect_light",
+    "fresnel",
+    "specular_lobe",
+];
+
+/// One generated case.
+pub struct Case {
+    /// The effect planted ("none": noise only).
+    pub effect: String,
+    /// The model to fit: the true scene without the effect, free list set.
+    pub model: Scene,
+    /// The scene that rendered the target (with the effect).
+    pub truth: Scene,
+    pub target: Image,
+}
+
+/// The base scene: sphere_floor at `w` x `h`, a glossy ball, eleven free
+/// parameters (light position and intensity, both colours, ball specular).
+/// `variant` 1 lights it from behind and gives the floor a gloss (where
+/// Fresnel shows); other variants move the light.
+pub fn base(w: u32, h: u32, variant: u32) -> Scene {
+    let text = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/sphere_floor.json"),
+    )
+    .unwrap();
+    let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
+    v["image"] = serde_json::json!({"width": w, "height": h});
+    v["free"] = serde_json::json!([
+        {"param": "lights.key.position", "min": [-3, 0.5, -3], "max": [3, 5, 5]},
+        {"param": "lights.key.intensity", "min": 1, "max": 50},
+        {"param": "objects.ball.material.color", "min": [0, 0, 0], "max": [1, 1, 1]},
+        {"param": "objects.floor.material.color", "min": [0, 0, 0], "max": [1, 1, 1]},
+        {"param": "objects.ball.material.specular", "min": 0, "max": 2}
+    ]);
+    let mut s = scenefit::scene::parse(&v.to_string(), "sphere_floor.json", &[]).unwrap();
+    match variant {
+        1 => {
+            s.lights[0].position = Some([1.5, 2.0, -2.0]);
+            s.objects[1].material.specular = 0.6;
+            s.objects[1].material.shininess = 15.0;
+        }
+        2 => s.lights[0].position = Some([-1.5, 3.5, 2.5]),
+        _ => {}
+    }
+    s
+}
+
+/// Plants `effect` at `strength` (1 = the reference strength) into `truth`.
+pub fn plant(truth: &mut Scene, effect: &str, strength: f64) {
+    match effect {
+        "ambient" => truth.ambient = [0.08 * strength; 3],
+        "light_falloff" => truth.lights[0].falloff_power = Some(2.0 - 1.0 * strength),
+        "second_light" => truth.lights.push(Light {
+            name: "hidden".into(),
+            kind: LightKind::Point,
+            position: Some([-2.0, 2.5, 1.5]),
+            direction: None,
+            color: [1.0, 1.0, 1.0],
+            intensity: 5.0 * strength,
+            falloff: Default::default(),
+            radius: 0.0,
+            falloff_power: None,
+        }),
+        "area_light" => truth.lights[0].radius = 0.7 * strength,
+        "vignetting" => {
+            truth.camera.vignetting = Some(Vignetting {
+                strength: 0.5 * strength,
+            })
+        }
+        "camera_response" => {
+            truth.camera.response = Some(Response {
+                gain: 1.0 + 0.2 * strength,
+                gamma: 1.0 - 0.3 * strength,
+                black: 0.0,
+            })
+        }
+        "indirect_light" => truth.indirect_light = Some(3.0 * strength),
+        "fresnel" => {
+            for o in &mut truth.objects {
+                o.material.fresnel = Some(0.04_f64.powf(strength));
+            }
+        }
+        "specular_lobe" => {
+            truth.objects[0].material.specular2 = Some(0.8 * strength);
+            truth.objects[0].material.shininess2 = Some(4.0);
+        }
+        _ => {}
+    }
+}
+
+/// Adds Gaussian noise of `sigma` 8-bit codes (seeded).
+pub fn add_noise(img: &mut Image, sigma: f64, seed: u64) {
+    if sigma <= 0.0 {
+        return;
+    }
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+    for v in img.iter_mut() {
+        // Box-Muller.
+        let (u1, u2): (f64, f64) = (rng.gen::<f64>().max(1e-12), rng.gen());
+        let z = (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos();
+        *v = (*v as f64 + sigma * z).round().clamp(0.0, 255.0) as u8;
+    }
+}
+
+/// The case for `effect` (or "none") on scene `variant`.
+pub fn case(effect: &str, variant: u32, strength: f64, seed: u64, noise: f64) -> Case {
+    let (w, h) = (64, 48);
+    let model = base(w, h, if effect == "fresnel" { 1 } else { variant });
+    let mut truth = model.clone();
+    plant(&mut truth, effect, strength);
+    let mut target = render_one(from_spec("phong").unwrap().as_ref(), &truth, 0).unwrap();
+    add_noise(&mut target, noise, seed);
+    Case {
+        effect: effect.into(),
+        model,
+        truth,
+        target,
+    }
+}
+
+/// Fits the case's model to its target into `dir` (the model lacks the effect).
+pub fn fit_case(c: &Case, dir: &Path, seed: u64) -> fit::FitResult {
+    let target = FitTarget {
+        image: c.target.clone(),
+        mask: None,
+        path: Some(dir.join("target.png")),
+    };
+    scenefit::render::image_io::write_image(&c.target, &dir.join("target.png")).unwrap();
+    let config = FitConfig {
+        de: DeConfig {
+            population: 30,
+            seed,
+            ..DeConfig::default()
+        },
+        generations: 60,
+        // Start near the truth, as a fit that has converged would be.
+        start_radius: Some(0.15),
+        snapshot_every: 1000,
+        ..FitConfig::default()
+    };
+    fit::run(
+        &c.model,
+        &target,
+        from_spec("phong").unwrap().as_ref(),
+        &config,
+        dir,
+        &mut (),
+    )
+    .unwrap()
+}
+
+/// The example scenes directory.
+pub fn scenes() -> std::path::PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes")
+}
