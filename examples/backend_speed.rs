@@ -9,7 +9,9 @@
 //! `--direct` sets `render.indirect` false. Renders/s counts the fit's
 //! evaluations over its wall time (worker start-up excluded, as the fit
 //! reports it); "outside" is 1 - (time renderers were busy) / (slots x
-//! wall time), slots = min(jobs, population). CPU per render splits the
+//! wall time), slots = min(jobs, population); "no render in flight" is the
+//! share of the fit's wall time in which scenefit alone was working (the
+//! optimizer, the metric, checkpoints, writing requests, reading images). CPU per render splits the
 //! CPU time into scenefit's own and its renderer processes' (workers are
 //! counted once they exit, at the end of the fit).
 
@@ -75,19 +77,22 @@ fn main() {
     let total = started.elapsed().as_secs_f64();
     let cpu_after = cpu_seconds();
     let (own, children) = (cpu_after.0 - cpu_before.0, cpu_after.1 - cpu_before.1);
-    let (attempts, busy) = stats::snapshot();
+    let (attempts, busy, idle) = stats::snapshot();
     let wall = result.wall_seconds;
     let slots = jobs.min(population) as f64;
     let outside = 1.0 - busy.as_secs_f64() / (slots * wall);
+    // no render in flight, less what the fit does not count (start-up)
+    let idle_share = ((idle.as_secs_f64() - (total - wall)) / wall).max(0.0);
     println!(
         "{renderer_name}: jobs {jobs}, population {population}, {} renders in {wall:.2} s = {:.1} renders/s; \
-         renderer busy {:.1} % of {slots} slots, outside {:.1} %; {attempts} attempts, {} failed; \
+         renderer busy {:.1} % of {slots} slots, outside {:.1} %; no render in flight {:.1} % of the time; {attempts} attempts, {} failed; \
          run incl. start-up {total:.2} s; deviation {:.3} %; \
          CPU per render: scenefit {:.1} ms, renderer processes {:.1} ms ({:.1} % in scenefit)",
         result.evaluations,
         result.evaluations as f64 / wall,
         100.0 * (1.0 - outside),
         100.0 * outside,
+        100.0 * idle_share,
         result.failed_renders,
         result.deviation.average,
         1e3 * own / result.evaluations as f64,

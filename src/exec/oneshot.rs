@@ -30,7 +30,7 @@ pub async fn run_process(spec: &CommandSpec, timeout: Duration) -> Result<String
         stderr: String::new(),
     })?;
     let pid = child.id();
-    let started = std::time::Instant::now();
+    let started = super::stats::begin();
     let tail = Tail::new();
     let drains: Vec<_> = [
         drain(child.stdout.take(), tail.clone()),
@@ -40,7 +40,7 @@ pub async fn run_process(spec: &CommandSpec, timeout: Duration) -> Result<String
     .flatten()
     .collect();
     let status = tokio::time::timeout(timeout, child.wait()).await;
-    super::stats::record(started.elapsed());
+    super::stats::end(started);
     let mut lingering = false;
     if status.is_ok() {
         for d in drains {

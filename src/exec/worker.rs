@@ -151,9 +151,9 @@ impl Worker {
         timeout: Duration,
     ) -> Result<(), RequestError> {
         self.mark = self.tail.mark();
-        let started = std::time::Instant::now();
+        let started = super::stats::begin();
         let result = self.exchange(line, id, timeout).await;
-        super::stats::record(started.elapsed());
+        super::stats::end(started);
         result
     }
 
