@@ -18,6 +18,7 @@
 //! smooth structure remains in the residual.
 
 pub mod library;
+pub mod photo;
 pub mod report;
 pub mod residual;
 
