@@ -73,7 +73,8 @@ fn neutral_values_render_identically() {
 fn each_effect_changes_the_image() {
     let base = scene("sphere_floor.json");
     let img = render(&base);
-    let cases: Vec<(&str, Box<dyn Fn(&mut Scene)>)> = vec![
+    type Change = Box<dyn Fn(&mut Scene)>;
+    let cases: Vec<(&str, Change)> = vec![
         (
             "vignetting",
             Box::new(|s| s.camera.vignetting = Some(Vignetting { strength: 0.5 })),
@@ -92,10 +93,7 @@ fn each_effect_changes_the_image() {
             "falloff",
             Box::new(|s| s.lights[0].falloff_power = Some(1.0)),
         ),
-        (
-            "radius",
-            Box::new(|s| s.lights[0].radius = Some(0.6).unwrap()),
-        ),
+        ("radius", Box::new(|s| s.lights[0].radius = 0.6)),
         ("indirect", Box::new(|s| s.indirect_light = Some(1.0))),
         (
             "fresnel",
