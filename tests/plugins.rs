@@ -142,7 +142,7 @@ fn one_shot_faults_fail_their_render_only() {
         return;
     }
     let _env = ENV.lock().unwrap_or_else(|p| p.into_inner());
-    std::env::set_var("SCENEFIT_RENDER_TIMEOUT", "1.5");
+    std::env::set_var("SCENEFIT_RENDER_TIMEOUT", "4");
     let started = std::time::Instant::now();
     let r = render_mix(
         &format!(
@@ -181,11 +181,11 @@ fn one_shot_faults_fail_their_render_only() {
     );
     let hang = failure(&r[7]);
     assert!(
-        hang.contains("timed out after 1.5 s") && hang.contains("hanging on purpose"),
+        hang.contains("timed out after 4 s") && hang.contains("hanging on purpose"),
         "{hang}"
     );
-    // two attempts of 1.5 s for the hang, the rest in parallel
-    assert!(started.elapsed().as_secs_f64() < 20.0);
+    // two attempts of 4 s for the hang, the rest in parallel (a loaded machine is slow)
+    assert!(started.elapsed().as_secs_f64() < 60.0);
 }
 
 #[test]
@@ -194,7 +194,7 @@ fn worker_faults_fail_their_render_only() {
         return;
     }
     let _env = ENV.lock().unwrap_or_else(|p| p.into_inner());
-    std::env::set_var("SCENEFIT_RENDER_TIMEOUT", "1.5");
+    std::env::set_var("SCENEFIT_RENDER_TIMEOUT", "4");
     let r = render_mix(
         &format!("worker:python3 {} --worker --fault mixed", faulty()),
         10,
@@ -227,7 +227,7 @@ fn worker_faults_fail_their_render_only() {
     assert!(failure(&r[6]).contains("is 8x6, expected 64x48"));
     let hang = failure(&r[8]);
     assert!(
-        hang.contains("timed out after 1.5 s and was killed")
+        hang.contains("timed out after 4 s and was killed")
             && hang.contains("hanging on purpose"),
         "{hang}"
     );
@@ -338,7 +338,7 @@ fn fit_survives_failing_renders_and_logs_them() {
             "3",
             "-q",
         ],
-        &[("SCENEFIT_RENDER_TIMEOUT", "1")],
+        &[("SCENEFIT_RENDER_TIMEOUT", "3")],
     );
     expect_code(&o, 0);
     let r = result(&d.join("run"));

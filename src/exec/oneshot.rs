@@ -32,7 +32,7 @@ pub async fn run_process(spec: &CommandSpec, timeout: Duration) -> Result<String
     let pid = child.id();
     let started = super::stats::begin();
     let tail = Tail::new();
-    let drains: Vec<_> = [
+    let mut drains: Vec<_> = [
         drain(child.stdout.take(), tail.clone()),
         drain(child.stderr.take(), tail.clone()),
     ]
@@ -41,18 +41,26 @@ pub async fn run_process(spec: &CommandSpec, timeout: Duration) -> Result<String
     .collect();
     let status = tokio::time::timeout(timeout, child.wait()).await;
     super::stats::end(started);
+    // a finished process closes its pipes; if they stay open, something it
+    // started still runs
     let mut lingering = false;
     if status.is_ok() {
-        for d in drains {
-            if tokio::time::timeout(PIPE_GRACE, d).await.is_err() {
-                lingering = true;
+        let mut open = Vec::new();
+        for mut d in drains {
+            if tokio::time::timeout(PIPE_GRACE, &mut d).await.is_err() {
+                open.push(d);
             }
         }
+        lingering = !open.is_empty();
+        drains = open;
     }
     if status.is_err() || lingering {
-        // timed out, or a child of it still runs: end the whole group
         kill_group(&mut child, pid);
         let _ = tokio::time::timeout(Duration::from_secs(5), child.wait()).await;
+        // collect what it printed last
+        for mut d in drains {
+            let _ = tokio::time::timeout(PIPE_GRACE, &mut d).await;
+        }
     }
     let text = tail.text();
     match status {
