@@ -25,7 +25,7 @@ that is not JSON, or a scene that cannot be built, is answered with ok:false
 ends the worker with exit code 0.  stderr carries Blender's render log and
 must be drained (or redirected) by the client.
 
-Scene -> Blender mapping (docs/conventions-draft.md)
+Scene -> Blender mapping (docs/renderers.md)
 ----------------------------------------------------
 Coordinates: scene is right-handed, y up, metres; Blender is right-handed,
 z up.  A scene point (x, y, z) becomes Blender (x, -z, y) (a +90 deg rotation

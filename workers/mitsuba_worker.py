@@ -26,7 +26,7 @@ kind), only the changed values are written through ``mi.traverse(scene)`` and
 ``params.update()``; otherwise the scene is rebuilt. samples and seed go to
 ``mi.render(scene, params, seed=..., spp=...)``, so they never force a rebuild.
 
-Mapping (docs/conventions-draft.md; scene: right-handed, y up, metres, linear RGB)
+Mapping (docs/renderers.md; scene: right-handed, y up, metres, linear RGB)
 -------------------------------------------------------------------------------
 Defaults: light color [1,1,1], falloff inverse_square, radius 0; material diffuse 1,
 specular 0, shininess 10, reflection 0, transmission 0, ior 1.5; ambient [0,0,0];
