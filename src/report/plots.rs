@@ -4,6 +4,7 @@
 //! plot) and the final population's light-versus-albedo scatter.
 
 use super::figure::{err, font, series_colour, DrawResult, Figure};
+use plotters::coord::combinators::BindKeyPoints;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
@@ -54,7 +55,10 @@ impl Figure for Convergence {
             .margin(12)
             .x_label_area_size(42)
             .y_label_area_size(58)
-            .build_cartesian_2d((x.0..x.1).log_scale(), (y.0..y.1).log_scale())
+            .build_cartesian_2d(
+                (x.0..x.1).log_scale().with_key_points(ticks_125(x)),
+                (y.0..y.1).log_scale().with_key_points(ticks_125(y)),
+            )
             .map_err(err)?;
         chart
             .configure_mesh()
@@ -100,6 +104,23 @@ impl Figure for Convergence {
             .map_err(err)?;
         Ok(())
     }
+}
+
+/// Ticks at 1, 2 and 5 times powers of ten within the range (plotters'
+/// own log axis labels only some powers of ten).
+fn ticks_125((lo, hi): (f64, f64)) -> Vec<f64> {
+    let mut out = Vec::new();
+    let mut decade = 10f64.powf(lo.log10().floor());
+    while decade <= hi {
+        for m in [1.0, 2.0, 5.0] {
+            let t = m * decade;
+            if t >= lo && t <= hi {
+                out.push(t);
+            }
+        }
+        decade *= 10.0;
+    }
+    out
 }
 
 /// A tick label without trailing zeros: 10, 0.5, 2000.
