@@ -227,8 +227,7 @@ fn worker_faults_fail_their_render_only() {
     assert!(failure(&r[6]).contains("is 8x6, expected 64x48"));
     let hang = failure(&r[8]);
     assert!(
-        hang.contains("timed out after 4 s and was killed")
-            && hang.contains("hanging on purpose"),
+        hang.contains("timed out after 4 s and was killed") && hang.contains("hanging on purpose"),
         "{hang}"
     );
 }
@@ -469,7 +468,7 @@ fn documented_plugin_example_works() {
 /// True while process `pid` exists (and is not a zombie).
 fn alive(pid: u32) -> bool {
     std::fs::read_to_string(format!("/proc/{pid}/stat"))
-        .is_ok_and(|s| !s.split_whitespace().nth(2).is_some_and(|st| st == "Z"))
+        .is_ok_and(|s| s.split_whitespace().nth(2).is_none_or(|st| st != "Z"))
 }
 
 #[test]
