@@ -60,9 +60,8 @@ fn first_accepted_effect_is_the_planted_one() {
             );
         }
     }
-    // The goal is 8 of 9; measured 7 (camera_response is taken for
-    // vignetting, Fresnel for a second lobe): see docs/results.md.
-    assert!(right >= 7, "{right} of 9 right:\n{}", lines.join("\n"));
+    // Measured 8 (camera_response is taken for vignetting): docs/results.md.
+    assert!(right >= 8, "{right} of 9 right:\n{}", lines.join("\n"));
     ratios.sort_by(f64::total_cmp);
     let median = ratios[ratios.len() / 2];
     assert!(

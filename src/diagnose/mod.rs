@@ -339,10 +339,43 @@ pub fn run(inputs: &Inputs, out: &Path, config: &DiagnoseConfig) -> Result<Diagn
 /// Light intensities, over their whole bounds, join the search of a new
 /// effect's parameters: an effect often moves the overall level (a falloff
 /// exponent scales by d^Δp, a response curve by its gain), which the fit
-/// without it had absorbed. (Narrowed colours were tried as well: they
-/// helped Fresnel and hurt four other effects on the generated data.)
-fn level_param(_scene: &Scene, f: &crate::scene::FreeParam) -> Option<crate::scene::FreeParam> {
-    (f.param.starts_with("lights.") && f.param.ends_with(".intensity")).then(|| f.clone())
+/// without it had absorbed. Fresnel, which whitens highlights the fit had
+/// matched with its colours, also brings the RGB colours, narrowed to
+/// ±30 % of their span around the current values. (Colours for every
+/// effect hurt four effects on the generated data; for the camera response
+/// too, they made it win on a falloff target without winning its own.)
+fn level_param(
+    scene: &Scene,
+    f: &crate::scene::FreeParam,
+    colours: bool,
+) -> Option<crate::scene::FreeParam> {
+    use crate::scene::{Bound, ColorSpace, Field, Value};
+    if f.param.starts_with("lights.") && f.param.ends_with(".intensity") {
+        return Some(f.clone());
+    }
+    if !(colours && f.param.ends_with(".color") && f.space == ColorSpace::Rgb) {
+        return None;
+    }
+    let Value::Vector(v) = Field::resolve(scene, &f.param).ok()?.get(scene)? else {
+        return None;
+    };
+    let comp = |b: Bound, i: usize| match b {
+        Bound::Scalar(x) => x,
+        Bound::Vector(v) => v[i],
+    };
+    let mut lo = [0.0; 3];
+    let mut hi = [0.0; 3];
+    for i in 0..3 {
+        let (a, b) = (comp(f.min, i), comp(f.max, i));
+        let r = 0.3 * (b - a);
+        lo[i] = (v[i] - r).max(a);
+        hi[i] = (v[i] + r).min(b);
+    }
+    Some(crate::scene::FreeParam {
+        min: Bound::Vector(lo),
+        max: Bound::Vector(hi),
+        ..f.clone()
+    })
 }
 
 /// Refits `scene`: when `added` is given, first those parameters alone over
@@ -380,12 +413,13 @@ fn refit(
         // intensities (an effect often changes the overall level: a falloff
         // exponent moves it by a factor of d). The unchanged model is one
         // individual of the start, so the search cannot end worse.
+        let colours = added.iter().any(|a| a.param.ends_with(".fresnel"));
         let mut only = current.clone();
         only.free = scene
             .free
             .iter()
             .filter(|f| !added.iter().any(|a| a.param == f.param))
-            .filter_map(|f| level_param(&current, f))
+            .filter_map(|f| level_param(&current, f, colours))
             .chain(added.iter().cloned())
             .collect();
         let c = FitConfig {
