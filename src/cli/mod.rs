@@ -31,12 +31,12 @@ enum Command {
     Render(render::RenderArgs),
     /// Fit a scene's free parameters to a target image.
     Fit(fit::FitArgs),
+    /// Find the effect a fit's model lacks, add it, refit, report before and after.
+    Diagnose(diagnose::DiagnoseArgs),
     /// Two-stage fit: Phong over the full bounds, then a physically based renderer around its result.
     Pipeline(pipeline::PipelineArgs),
     /// (Re)write report.html of a fit or pipeline directory.
     Report(report::ReportArgs),
-    /// Find the effect a fit's model lacks, add it, refit, report before and after.
-    Diagnose(diagnose::DiagnoseArgs),
 }
 
 /// Runs the command line; returns the process exit code.
@@ -46,7 +46,11 @@ pub fn main() -> i32 {
         Err(e) if e.use_stderr() => {
             // One line: clap's message up to its first blank line, joined.
             let text = e.render().to_string();
-            let first: Vec<&str> = text.lines().take_while(|l| !l.trim().is_empty()).map(str::trim).collect();
+            let first: Vec<&str> = text
+                .lines()
+                .take_while(|l| !l.trim().is_empty())
+                .map(str::trim)
+                .collect();
             eprintln!("{} (see --help)", first.join(" "));
             return 2;
         }
@@ -59,9 +63,9 @@ pub fn main() -> i32 {
         Command::Demo(a) => demo::run(a),
         Command::Render(a) => render::run(a),
         Command::Fit(a) => fit::run(a),
+        Command::Diagnose(a) => diagnose::run(a),
         Command::Pipeline(a) => pipeline::run(a),
         Command::Report(a) => report::run(a),
-        Command::Diagnose(a) => diagnose::run(a),
     };
     match result {
         Ok(()) => 0,
