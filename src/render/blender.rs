@@ -51,6 +51,9 @@ impl Renderer for Blender {
         let script = write_script(&dir, "blender_worker.py", WORKER)?;
         let spec = CommandSpec::new(program)
             .cwd(dir.path())
+            // Blender makes a temp dir per process and leaves it when killed
+            // (restarts, timeouts): keep those inside the run's own dir.
+            .env("TMPDIR", dir.path())
             .args([
                 "-b",
                 "--factory-startup",
