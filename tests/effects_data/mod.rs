@@ -12,17 +12,8 @@ use scenefit::render::{from_spec, render_one, Image};
 use scenefit::scene::{Light, LightKind, Response, Scene, Vignetting};
 use std::path::Path;
 
-pub const EFFECTS: [&str; 9] = [
-    "ambient",
-    "light_falloff",
-    "second_light",
-    "area_light",
-    "vignetting",
-    "camera_response",
-    "indirect_light",
-    "fresnel",
-    "specular_lobe",
-];
+/// The effects the diagnosis knows, in DESIGN.md order.
+pub use scenefit::diagnose::library::EFFECTS;
 
 /// One generated case.
 pub struct Case {
