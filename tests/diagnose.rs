@@ -9,8 +9,13 @@ use scenefit::diagnose::{self, DiagnoseConfig, Inputs};
 
 fn diagnose_case(effect: &str, variant: u32, seed: u64, noise: f64) -> diagnose::Diagnosis {
     let c = case(effect, variant, 1.0, seed, noise);
-    let dir = tempfile::tempdir().unwrap();
-    let fit_dir = dir.path().join("fit");
+    let tmp = tempfile::tempdir().unwrap();
+    // DIAG_KEEP=DIR keeps each case's fit and diagnosis there (when tuning).
+    let dir = match std::env::var("DIAG_KEEP") {
+        Ok(keep) => std::path::Path::new(&keep).join(format!("{effect}-{seed}-{noise}")),
+        Err(_) => tmp.path().to_path_buf(),
+    };
+    let fit_dir = dir.join("fit");
     std::fs::create_dir_all(&fit_dir).unwrap();
     fit_case(&c, &fit_dir, seed);
     let inputs = Inputs::from_fit_dir(&fit_dir, None, None).unwrap();
@@ -19,7 +24,7 @@ fn diagnose_case(effect: &str, variant: u32, seed: u64, noise: f64) -> diagnose:
         seed,
         ..DiagnoseConfig::default()
     };
-    diagnose::run(&inputs, &dir.path().join("diag"), &config).unwrap()
+    diagnose::run(&inputs, &dir.join("diag"), &config).unwrap()
 }
 
 #[test]

@@ -106,13 +106,18 @@ pub struct FitArgs {
     /// Override a scene field: PARAM=JSON.
     #[arg(long = "set", value_name = "PARAM=JSON")]
     set: Vec<Override>,
+    /// Free a photograph's nuisance parameters too: exposure (0.25-4),
+    /// white_balance (0.5-2 per channel).
+    #[arg(long, value_delimiter = ',', value_name = "NAMES")]
+    nuisance: Vec<crate::scene::Nuisance>,
     /// No progress output.
     #[arg(long, short)]
     quiet: bool,
 }
 
 pub fn run(a: FitArgs) -> Result<()> {
-    let scene = load_with(&a.scene, &a.set)?;
+    let mut scene = load_with(&a.scene, &a.set)?;
+    crate::scene::nuisance::add(&mut scene, &a.nuisance);
     let image = image_io::read_target(&a.target, scene.image.width, scene.image.height)?;
     let mask = a
         .mask

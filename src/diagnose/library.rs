@@ -22,6 +22,32 @@ pub const EFFECTS: [&str; 9] = [
 pub struct Extension {
     pub scene: Scene,
     pub added: Vec<FreeParam>,
+    /// Other starting points for the effect's search, where the parameters
+    /// the fit without it had bent to absorb it are bent back (the diagnosis
+    /// renders each and starts from the best, `scene` included).
+    pub starts: Vec<Scene>,
+    /// Parameters already fitted that the effect trades with, searched
+    /// together with its own.
+    pub companions: Companions,
+}
+
+/// Which fitted parameters join the search of a new effect's own. Light
+/// intensities always do, over their whole bounds: an effect often moves
+/// the overall level (a falloff exponent by d^Δp, a response by its gain),
+/// which the fit without it had absorbed.
+#[derive(Clone, Copy, Debug)]
+pub struct Companions {
+    /// RGB colours, within ±30 % of their span around the fitted values:
+    /// Fresnel whitens highlights the fit had matched with its colours.
+    /// (Colours for every effect hurt four effects on the generated data.)
+    pub colours: bool,
+    /// Light positions over their whole bounds: a fit without a falloff
+    /// exponent moves the light to fake it (further away for a slower
+    /// falloff), too far for a refit close to the fitted values to undo.
+    pub light_positions: bool,
+    /// Unit-cube radius of the search's start around the current values (1:
+    /// uniform over the bounds).
+    pub radius: f64,
 }
 
 fn free(param: impl Into<String>, min: Bound, max: Bound) -> FreeParam {
@@ -208,7 +234,200 @@ pub fn extend(scene: &Scene, effect: &str) -> Option<Extension> {
         return None;
     }
     s.free.extend(added.iter().cloned());
-    Some(Extension { scene: s, added })
+    let starts = match effect {
+        "camera_response" => response_starts(&s),
+        "light_falloff" => falloff_starts(&s, &added[0].param),
+        _ => Vec::new(),
+    };
+    let companions = Companions {
+        colours: effect == "fresnel",
+        light_positions: matches!(effect, "light_falloff" | "camera_response"),
+        // Both trade with the light's distance along a narrow valley: a
+        // start spread over the whole bounds rarely lands in it, so their
+        // searches start around the best of their starts.
+        radius: if effect == "camera_response" {
+            0.35
+        } else {
+            1.0
+        },
+    };
+    Some(Extension {
+        scene: s,
+        added,
+        starts,
+        companions,
+    })
+}
+
+/// Gammas tried as starts of a camera response search (its bounds: 0.4-2.5).
+const GAMMAS: [f64; 11] = [0.5, 0.6, 0.7, 0.8, 0.9, 1.15, 1.35, 1.6, 1.9, 2.2, 2.5];
+
+/// Scales of a point light's distance to the look-at point tried with them.
+const DISTANCES: [f64; 5] = [0.55, 0.7, 0.85, 1.0, 1.2];
+
+/// Falloff exponents tried as starts (bounds 0-4).
+const POWERS: [f64; 7] = [0.0, 0.5, 1.0, 1.5, 2.5, 3.0, 4.0];
+
+/// Starts for a falloff exponent: a fit without it had faked a slower
+/// falloff by moving the light away (a faster one, closer), so each
+/// exponent is tried at several distances, the level matched after.
+fn falloff_starts(scene: &Scene, param: &str) -> Vec<Scene> {
+    use crate::scene::{Field, Value};
+    let Ok(field) = Field::resolve(scene, param) else {
+        return Vec::new();
+    };
+    let mut starts = Vec::new();
+    for &p in &POWERS {
+        let mut s = scene.clone();
+        field.set(&mut s, Value::Scalar(p));
+        for &d in &DISTANCES {
+            starts.push(closer(&s, d));
+        }
+    }
+    starts
+}
+
+/// Starts for a camera response. A fit without it had absorbed the curve
+/// into its free colours: a target (c L)^γ is matched best by colours c^γ.
+/// So each start sets a gamma and bends them back, c -> c^(1/γ), which
+/// keeps the colours the fit found and changes only the shading (the
+/// start renders c L^γ, its level then matched). A gamma below 1 flattens the shading, which the
+/// fit had also faked by moving a free point light away (keeping the
+/// irradiance at the look-at point with more intensity), so each gamma is
+/// also tried with the light brought closer, and every start also without
+/// its specular lobe ([`matte_variant`]). Without these starts, a search
+/// over the curve, colours fixed, cannot reach a strong gamma.
+fn response_starts(scene: &Scene) -> Vec<Scene> {
+    let mut starts = Vec::new();
+    for matte in [false, true] {
+        let base = if matte {
+            matte_variant(scene)
+        } else {
+            scene.clone()
+        };
+        for &d in &DISTANCES {
+            let near = closer(&base, d);
+            for &g in &GAMMAS {
+                starts.push(bend(&near, g));
+            }
+        }
+    }
+    starts
+}
+
+/// `scene` with its free specular levels at their lower bounds: a fit
+/// without the response may have faked the curve's flattened or steepened
+/// shading with a broad specular lobe, which under the right curve would
+/// be far too bright; the refit grows the real lobe back.
+fn matte_variant(scene: &Scene) -> Scene {
+    let mut s = scene.clone();
+    for f in &scene.free {
+        if !(f.param.starts_with("objects.") && f.param.ends_with(".material.specular")) {
+            continue;
+        }
+        if let Ok(field) = crate::scene::Field::resolve(scene, &f.param) {
+            field.set(&mut s, crate::scene::Value::Scalar(component(f.min, 0)));
+        }
+    }
+    s
+}
+
+/// `scene` with its free point lights at `scale` times their distance to
+/// the look-at point, their free intensities scaled to keep the irradiance
+/// there.
+fn closer(scene: &Scene, scale: f64) -> Scene {
+    let mut s = scene.clone();
+    let look = V3::from(scene.camera.look_at);
+    for l in &mut s.lights {
+        let Some(p) = l.position else { continue };
+        let Some(f) = scene
+            .free
+            .iter()
+            .find(|f| f.param == format!("lights.{}.position", l.name))
+        else {
+            continue;
+        };
+        let q = look + (V3::from(p) - look) * scale;
+        let q = [q.x, q.y, q.z];
+        l.position = Some(std::array::from_fn(|i| {
+            q[i].clamp(component(f.min, i), component(f.max, i))
+        }));
+        let power = l.falloff_power.unwrap_or(match l.falloff {
+            Falloff::InverseSquare => 2.0,
+            Falloff::None => 0.0,
+        });
+        l.intensity *= scale.powf(power);
+        if let Some(f) = scene
+            .free
+            .iter()
+            .find(|f| f.param == format!("lights.{}.intensity", l.name))
+        {
+            l.intensity = l.intensity.clamp(component(f.min, 0), component(f.max, 0));
+        }
+    }
+    s
+}
+
+/// `scene` with the response's gamma at `g` and its free RGB colours bent
+/// back by 1/g (clamped to their bounds); the diagnosis then matches the
+/// level with [`match_level`].
+fn bend(scene: &Scene, g: f64) -> Scene {
+    use crate::scene::{ColorSpace, Field, Value};
+    let mut s = scene.clone();
+    if let Some(r) = s.camera.response.as_mut() {
+        r.gamma = g;
+    }
+    for f in &scene.free {
+        let colour = f.param.ends_with(".color")
+            && f.param.starts_with("objects.")
+            && f.space == ColorSpace::Rgb;
+        if !colour {
+            continue;
+        }
+        let Ok(field) = Field::resolve(scene, &f.param) else {
+            continue;
+        };
+        let back = |v: f64, i: usize| {
+            v.max(0.0)
+                .powf(1.0 / g)
+                .clamp(component(f.min, i), component(f.max, i))
+        };
+        let value = match field.get(scene) {
+            Some(Value::Scalar(v)) => Value::Scalar(back(v, 0)),
+            Some(Value::Vector(v)) => Value::Vector([back(v[0], 0), back(v[1], 1), back(v[2], 2)]),
+            _ => continue,
+        };
+        field.set(&mut s, value);
+    }
+    s
+}
+
+/// `scene` with its free light intensities scaled so that its linear image
+/// level is multiplied by `k` (through the response's gamma, if any), each
+/// clamped to its bounds: a start's level is matched to the target's before
+/// it is compared.
+pub fn match_level(scene: &Scene, k: f64) -> Scene {
+    let gamma = scene.camera.response.map_or(1.0, |r| r.gamma);
+    let factor = k.max(0.0).powf(1.0 / gamma.max(1e-3));
+    let mut s = scene.clone();
+    for l in &mut s.lights {
+        let Some(f) = scene
+            .free
+            .iter()
+            .find(|f| f.param == format!("lights.{}.intensity", l.name))
+        else {
+            continue;
+        };
+        l.intensity = (l.intensity * factor).clamp(component(f.min, 0), component(f.max, 0));
+    }
+    s
+}
+
+fn component(b: Bound, i: usize) -> f64 {
+    match b {
+        Bound::Scalar(x) => x,
+        Bound::Vector(v) => v[i],
+    }
 }
 
 /// Which effect a free parameter belongs to (for the report).

@@ -47,6 +47,12 @@ pub struct DiagnoseConfig {
     pub refine_generations: usize,
     /// Unit-cube radius of the warm start of the joint refit.
     pub start_radius: f64,
+    /// Generations of the final refit of an accepted effect's model (every
+    /// parameter, warm-started within `polish_radius`): the refits that
+    /// choose between effects are short and start close, so parameters the
+    /// fit without the effect had bent far to absorb it stay bent.
+    pub polish_generations: usize,
+    pub polish_radius: f64,
     /// Effects accepted at most.
     pub max_rounds: usize,
     /// Least relative drop of the residual sum of squares to accept.
@@ -66,6 +72,8 @@ impl Default for DiagnoseConfig {
             search_generations: 40,
             refine_generations: 40,
             start_radius: 0.08,
+            polish_generations: 80,
+            polish_radius: 0.25,
             max_rounds: 3,
             min_gain: 0.05,
             bic_margin: 10.0,
@@ -216,7 +224,10 @@ pub fn run(inputs: &Inputs, out: &Path, config: &DiagnoseConfig) -> Result<Diagn
         inputs,
         config,
         &refits.join("none_0"),
-        config.search_generations + config.refine_generations,
+        Refine::close(
+            config,
+            config.search_generations + config.refine_generations,
+        ),
     )?;
     renders += null.2;
     if null.1 < model.sad {
@@ -244,14 +255,16 @@ pub fn run(inputs: &Inputs, out: &Path, config: &DiagnoseConfig) -> Result<Diagn
                 continue;
             };
             let added = ParamSpace::from_scene(&ext.scene).dim() - k0;
+            let (start, count) = best_start(renderer.as_ref(), &ext, inputs)?;
+            renders += count;
             let (scene, r, count, image) = refit(
                 renderer.as_ref(),
-                &ext.scene,
-                Some(&ext.added),
+                &start,
+                Some((&ext.added, ext.companions)),
                 inputs,
                 config,
                 &refits.join(format!("{effect}_{round}")),
-                config.refine_generations,
+                Refine::close(config, config.refine_generations),
             )?;
             renders += count;
             let dev = deviation(target, &image, mask);
@@ -301,9 +314,33 @@ pub fn run(inputs: &Inputs, out: &Path, config: &DiagnoseConfig) -> Result<Diagn
             }
             candidates.push(c);
         }
-        match next {
-            Some(m) => model = m,
-            None => break,
+        let Some(m) = next else {
+            break;
+        };
+        model = m;
+        if config.polish_generations > 0 {
+            let name = accepted.last().expect("just accepted");
+            let polished = refit(
+                renderer.as_ref(),
+                &model.scene,
+                None,
+                inputs,
+                config,
+                &refits.join(format!("{name}_{round}_polish")),
+                Refine {
+                    generations: config.polish_generations,
+                    radius: config.polish_radius,
+                    population: config.search_population,
+                },
+            )?;
+            renders += polished.2;
+            if polished.1 < model.sad {
+                model = Model {
+                    scene: polished.0,
+                    sad: polished.1,
+                    image: polished.3,
+                };
+            }
         }
     }
     let after = deviation(target, &model.image, mask);
@@ -336,24 +373,22 @@ pub fn run(inputs: &Inputs, out: &Path, config: &DiagnoseConfig) -> Result<Diagn
     Ok(diagnosis)
 }
 
-/// Light intensities, over their whole bounds, join the search of a new
-/// effect's parameters: an effect often moves the overall level (a falloff
-/// exponent scales by d^Δp, a response curve by its gain), which the fit
-/// without it had absorbed. Fresnel, which whitens highlights the fit had
-/// matched with its colours, also brings the RGB colours, narrowed to
-/// ±30 % of their span around the current values. (Colours for every
-/// effect hurt four effects on the generated data; for the camera response
-/// too, they made it win on a falloff target without winning its own.)
-fn level_param(
+/// `f` as it joins the search of a new effect's parameters (None: it
+/// stays fixed there); see [`library::Companions`].
+fn companion(
     scene: &Scene,
     f: &crate::scene::FreeParam,
-    colours: bool,
+    with: library::Companions,
 ) -> Option<crate::scene::FreeParam> {
     use crate::scene::{Bound, ColorSpace, Field, Value};
-    if f.param.starts_with("lights.") && f.param.ends_with(".intensity") {
+    let light = f.param.starts_with("lights.");
+    if light
+        && (f.param.ends_with(".intensity")
+            || (with.light_positions && f.param.ends_with(".position")))
+    {
         return Some(f.clone());
     }
-    if !(colours && f.param.ends_with(".color") && f.space == ColorSpace::Rgb) {
+    if !(with.colours && f.param.ends_with(".color") && f.space == ColorSpace::Rgb) {
         return None;
     }
     let Value::Vector(v) = Field::resolve(scene, &f.param).ok()?.get(scene)? else {
@@ -378,6 +413,83 @@ fn level_param(
     })
 }
 
+/// The start of an effect's search: the extended scene or one of its
+/// alternative starts (each with its level matched to the target's),
+/// whichever renders closest to the target. Returns it and the renders
+/// spent.
+fn best_start(
+    renderer: &dyn Renderer,
+    ext: &library::Extension,
+    inputs: &Inputs,
+) -> Result<(Scene, usize)> {
+    if ext.starts.is_empty() {
+        return Ok((ext.scene.clone(), 0));
+    }
+    let mask = inputs.mask.as_ref();
+    let target_level = level(&inputs.target, mask);
+    let mut best = (f64::INFINITY, ext.scene.clone());
+    let mut renders = 0;
+    for s in std::iter::once(&ext.scene).chain(&ext.starts) {
+        // A start the renderer refuses is no start; the others remain.
+        renders += 1;
+        let Ok(img) = render_one(renderer, s, 0) else {
+            continue;
+        };
+        let mut candidates = vec![(s.clone(), img.clone())];
+        let own = level(&img, mask);
+        if own > 0.0 {
+            let matched = library::match_level(s, target_level / own);
+            renders += 1;
+            if let Ok(img) = render_one(renderer, &matched, 0) {
+                candidates.push((matched, img));
+            }
+        }
+        for (scene, img) in candidates {
+            let d = sad(&inputs.target, &img, mask);
+            if d < best.0 {
+                best = (d, scene);
+            }
+        }
+    }
+    Ok((best.1, renders))
+}
+
+/// The mean linear value over the mask's channel values.
+fn level(img: &Image, mask: Option<&Mask>) -> f64 {
+    let lut: Vec<f64> = (0..=255u8).map(crate::render::srgb::decode).collect();
+    let raw = img.as_raw();
+    let (sum, n) = match mask {
+        Some(m) => m.pixels().iter().fold((0.0, 0usize), |(s, n), &p| {
+            let i = 3 * p as usize;
+            (
+                s + lut[raw[i] as usize] + lut[raw[i + 1] as usize] + lut[raw[i + 2] as usize],
+                n + 3,
+            )
+        }),
+        None => (raw.iter().map(|&v| lut[v as usize]).sum(), raw.len()),
+    };
+    sum / n.max(1) as f64
+}
+
+/// How the joint refit of every parameter runs.
+struct Refine {
+    generations: usize,
+    /// Unit-cube radius around the current values.
+    radius: f64,
+    population: usize,
+}
+
+impl Refine {
+    /// The short refit, close to the current values, that compares effects.
+    fn close(config: &DiagnoseConfig, generations: usize) -> Refine {
+        Refine {
+            generations,
+            radius: config.start_radius,
+            population: config.population,
+        }
+    }
+}
+
 /// Refits `scene`: when `added` is given, first those parameters alone over
 /// their bounds, then all parameters warm-started around the result.
 /// Returns the scene, its residual sum of squares, the renders spent and
@@ -385,11 +497,11 @@ fn level_param(
 fn refit(
     renderer: &dyn Renderer,
     scene: &Scene,
-    added: Option<&[crate::scene::FreeParam]>,
+    added: Option<(&[crate::scene::FreeParam], library::Companions)>,
     inputs: &Inputs,
     config: &DiagnoseConfig,
     dir: &Path,
-    refine_generations: usize,
+    refine: Refine,
 ) -> Result<(Scene, f64, usize, Image)> {
     let target = FitTarget {
         image: inputs.target.clone(),
@@ -400,6 +512,10 @@ fn refit(
         de: DeConfig {
             population: config.population,
             seed: config.seed,
+            // Current-to-pbest: every refit starts from a good point, which
+            // SHADE exploits; DE/rand/1 spent whole polishes without
+            // improving on their start.
+            strategy: crate::optimize::Strategy::Shade,
             ..DeConfig::default()
         },
         jobs: config.jobs,
@@ -408,23 +524,21 @@ fn refit(
     };
     let mut current = scene.clone();
     let mut renders = 0;
-    if let Some(added) = added {
-        // The effect's parameters over their whole bounds, with the light
-        // intensities (an effect often changes the overall level: a falloff
-        // exponent moves it by a factor of d). The unchanged model is one
-        // individual of the start, so the search cannot end worse.
-        let colours = added.iter().any(|a| a.param.ends_with(".fresnel"));
+    if let Some((added, with)) = added {
+        // The effect's parameters over their whole bounds, with those it
+        // trades with. The unchanged model is one individual of the start,
+        // so the search cannot end worse.
         let mut only = current.clone();
         only.free = scene
             .free
             .iter()
             .filter(|f| !added.iter().any(|a| a.param == f.param))
-            .filter_map(|f| level_param(&current, f, colours))
+            .filter_map(|f| companion(&current, f, with))
             .chain(added.iter().cloned())
             .collect();
         let c = FitConfig {
             generations: config.search_generations,
-            start_radius: Some(1.0),
+            start_radius: Some(with.radius),
             de: DeConfig {
                 population: config.search_population,
                 ..base.de.clone()
@@ -437,8 +551,12 @@ fn refit(
         current.free = scene.free.clone();
     }
     let c = FitConfig {
-        generations: refine_generations,
-        start_radius: Some(config.start_radius),
+        generations: refine.generations,
+        start_radius: Some(refine.radius),
+        de: DeConfig {
+            population: refine.population,
+            ..base.de.clone()
+        },
         ..base
     };
     let r = fit::run(

@@ -1,15 +1,18 @@
-//! Image-space camera effects applied after any backend: vignetting and the
+//! Image-space camera effects applied after any backend: vignetting, the
 //! camera's response curve (DESIGN.md effects `vignetting`,
-//! `camera_response`). A wrapper around every renderer, so no backend needs
-//! to know these fields.
+//! `camera_response`) and a photograph's exposure and white balance (the
+//! nuisance parameters `fit --nuisance` frees). A wrapper around every
+//! renderer, so no backend needs to know these fields.
 //!
 //! ```json
 //! "camera": {..., "vignetting": {"strength": 0.3},
-//!            "response": {"gain": 1.1, "gamma": 0.9, "black": 0.01}}
+//!            "response": {"gain": 1.1, "gamma": 0.9, "black": 0.01},
+//!            "exposure": 1.2, "white_balance": [1.0, 0.95, 1.1]}
 //! ```
 //! Each 8-bit sRGB pixel is decoded to linear v, then
 //! `v * (1 - strength * r^2)` (r: distance from the image centre over the
-//! half-diagonal), then `black + gain * v^gamma`, then sRGB-encoded again.
+//! half-diagonal), times exposure and the channel's white balance, then
+//! `black + gain * v^gamma`, then sRGB-encoded again.
 //! A scene without these fields passes through untouched.
 
 use super::srgb::{decode, encode};
@@ -74,6 +77,8 @@ impl RenderSession for CameraEffectsSession {
 /// True when the camera has an image-space effect that changes pixels.
 pub fn has_effects(cam: &Camera) -> bool {
     cam.vignetting.is_some_and(|v| v.strength != 0.0)
+        || cam.exposure.is_some_and(|e| e != 1.0)
+        || cam.white_balance.is_some_and(|wb| wb != [1.0; 3])
         || cam
             .response
             .is_some_and(|r| r.gain != 1.0 || r.gamma != 1.0 || r.black != 0.0)
@@ -90,11 +95,13 @@ pub fn apply(cam: &Camera, img: &mut Image) {
     let half_diag2 = cx * cx + cy * cy;
     let k = cam.vignetting.map_or(0.0, |v| v.strength);
     let resp = cam.response.unwrap_or_default();
+    let exposure = cam.exposure.unwrap_or(1.0);
+    let balance = cam.white_balance.unwrap_or([1.0; 3]).map(|b| b * exposure);
     for (x, y, px) in img.enumerate_pixels_mut() {
         let (dx, dy) = (x as f64 + 0.5 - cx, y as f64 + 0.5 - cy);
         let fall = 1.0 - k * (dx * dx + dy * dy) / half_diag2;
-        for c in px.0.iter_mut() {
-            let v = lut[*c as usize] * fall;
+        for (c, b) in px.0.iter_mut().zip(balance) {
+            let v = lut[*c as usize] * fall * b;
             let v = resp.black + resp.gain * v.max(0.0).powf(resp.gamma);
             *c = encode(v);
         }
@@ -116,6 +123,8 @@ mod tests {
             height: None,
             vignetting: None,
             response: None,
+            exposure: None,
+            white_balance: None,
         }
     }
 

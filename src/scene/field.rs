@@ -69,6 +69,8 @@ pub enum CameraField {
     ResponseGain,
     ResponseGamma,
     ResponseBlack,
+    Exposure,
+    WhiteBalance,
 }
 
 /// A field's value: a number or a 3-vector.
@@ -165,6 +167,8 @@ impl Field {
                     "up" => CameraField::Up,
                     "fov_y_deg" => CameraField::FovY,
                     "height" => CameraField::Height,
+                    "exposure" => CameraField::Exposure,
+                    "white_balance" => CameraField::WhiteBalance,
                     other => return Err(format!("the camera has no numeric field \"{other}\"")),
                 };
                 let field = Field::Camera(f);
@@ -246,6 +250,8 @@ impl Field {
                     CameraField::ResponseGain => Scalar(c.response?.gain),
                     CameraField::ResponseGamma => Scalar(c.response?.gamma),
                     CameraField::ResponseBlack => Scalar(c.response?.black),
+                    CameraField::Exposure => Scalar(c.exposure?),
+                    CameraField::WhiteBalance => Vector(c.white_balance?),
                 }
             }
         })
@@ -345,6 +351,8 @@ impl Field {
                             s(&mut r.black, value)
                         }
                     }
+                    CameraField::Exposure => os(&mut c.exposure, value),
+                    CameraField::WhiteBalance => ov(&mut c.white_balance, value),
                 }
             }
         }
@@ -387,6 +395,8 @@ impl Field {
                     | CameraField::ResponseGain
                     | CameraField::ResponseGamma
                     | CameraField::ResponseBlack
+                    | CameraField::Exposure
+                    | CameraField::WhiteBalance
             )
         )
     }

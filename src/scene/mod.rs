@@ -5,11 +5,13 @@
 pub mod color;
 pub mod field;
 pub mod load;
+pub mod nuisance;
 pub mod params;
 pub mod types;
 pub mod validate;
 
 pub use field::{Field, Value};
 pub use load::{load, load_with, parse, Override};
+pub use nuisance::Nuisance;
 pub use params::{ParamSpace, ParamSpec};
 pub use types::*;

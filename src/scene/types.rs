@@ -64,6 +64,12 @@ pub struct Camera {
     /// The camera's response curve on linear values (absent: identity).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub response: Option<Response>,
+    /// A photograph's exposure: linear values times this (absent: 1).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub exposure: Option<f64>,
+    /// A photograph's white balance: linear R, G, B times these (absent: 1).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub white_balance: Option<Vec3>,
 }
 
 /// radiance x (1 - strength * r^2), r the distance from the image centre

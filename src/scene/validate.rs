@@ -211,6 +211,14 @@ fn effects(scene: &Scene, file: &str) -> Result<()> {
             ));
         }
     }
+    if let Some(e) = scene.camera.exposure {
+        positive(file, "camera.exposure", e)?;
+    }
+    if let Some(wb) = scene.camera.white_balance {
+        for (c, v) in ["r", "g", "b"].iter().zip(wb) {
+            positive(file, &format!("camera.white_balance ({c})"), v)?;
+        }
+    }
     if let Some(r) = scene.camera.response {
         positive(file, "camera.response.gain", r.gain)?;
         positive(file, "camera.response.gamma", r.gamma)?;
@@ -470,7 +478,8 @@ fn free(scene: &Scene, f: &FreeParam, file: &str, at: &str) -> Result<()> {
                 super::field::CameraField::FovY
                 | super::field::CameraField::Height
                 | super::field::CameraField::ResponseGain
-                | super::field::CameraField::ResponseGamma,
+                | super::field::CameraField::ResponseGamma
+                | super::field::CameraField::Exposure,
             )
             | Field::Shape(..) => f64::MIN_POSITIVE,
             _ => 0.0,
