@@ -62,6 +62,7 @@ fn main() {
             de: DeConfig {
                 population: 40,
                 seed: i as u64,
+                strategy: scenefit::optimize::Strategy::Shade,
                 ..DeConfig::default()
             },
             generations: 150,

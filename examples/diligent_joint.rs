@@ -2,7 +2,8 @@
 //! shininess) shared by all, each photograph with its own light direction
 //! and intensity, searched by one DE over all of them at once:
 //! `cargo run --release --example diligent_joint -- [IMAGES] [GENERATIONS]`
-//! (default images 1,25,49,73, 400 generations).
+//! (default images 1,25,49,73, 400 generations). `GAMMA=2.2` declares the
+//! linear photographs' response; `EFFECTS=ambient` adds effects (shared).
 
 use scenefit::diagnose::photo;
 use scenefit::metric::{deviation, Deviation};
@@ -31,6 +32,16 @@ fn main() {
             gamma: g,
             ..Default::default()
         });
+    }
+    // EFFECTS=ambient,...: effects the diagnosis of single photographs
+    // accepted, added to the shared model (their parameters shared too).
+    for effect in std::env::var("EFFECTS").unwrap_or_default().split(',') {
+        if effect.is_empty() {
+            continue;
+        }
+        scene = scenefit::diagnose::library::extend(&scene, effect)
+            .unwrap_or_else(|| panic!("effect {effect} does not apply"))
+            .scene;
     }
     let space = ParamSpace::from_scene(&scene);
     // The scene's order: direction (3), intensity (1), then the material (5).
@@ -103,6 +114,7 @@ fn main() {
     );
     println!("| image | angular error (°) | deviation (%) |\n|---|---|---|");
     let mut devs = Vec::new();
+    let mut errors = Vec::new();
     for (j, (img, mask)) in targets.iter().enumerate() {
         let s = space.scene_at(&scene, &unit_for(&best, j));
         let im = session
@@ -118,18 +130,22 @@ fn main() {
         let g = truth[images[j] - 1];
         let n = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
         let c = (v[0] * g[0] + v[1] * g[1] + v[2] * g[2]) / n;
-        println!(
-            "| {:03} | {:.2} | {:.3} |",
-            images[j],
-            c.clamp(-1.0, 1.0).acos().to_degrees(),
-            d.average
-        );
+        let err = c.clamp(-1.0, 1.0).acos().to_degrees();
+        errors.push(err);
+        println!("| {:03} | {err:.2} | {:.3} |", images[j], d.average);
         devs.push(d.average);
     }
+    errors.sort_by(f64::total_cmp);
+    devs.sort_by(f64::total_cmp);
+    println!(
+        "median angular error {:.2}°, median deviation {:.3} %",
+        errors[errors.len() / 2],
+        devs[devs.len() / 2]
+    );
     let s = space.scene_at(&scene, &unit_for(&best, 0));
     let m = &s.objects[0].material;
     println!(
-        "shared material: color [{:.3}, {:.3}, {:.3}], specular {:.3}, shininess {:.1}",
-        m.color[0], m.color[1], m.color[2], m.specular, m.shininess
+        "shared material: color [{:.3}, {:.3}, {:.3}], specular {:.3}, shininess {:.1}; ambient {:.3}",
+        m.color[0], m.color[1], m.color[2], m.specular, m.shininess, s.ambient[0]
     );
 }

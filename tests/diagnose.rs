@@ -1,6 +1,7 @@
 //! `scenefit diagnose` on generated data (tests/effects_data): the first
 //! accepted effect is the planted one for at least 8 of the 9 effects, the
-//! deviation falls to at most half, and noise-only targets accept nothing.
+//! deviation falls to at most half for every one, and noise-only targets
+//! accept nothing.
 
 mod effects_data;
 
@@ -38,7 +39,14 @@ fn first_accepted_effect_is_the_planted_one() {
             continue;
         }
         let t = std::time::Instant::now();
-        let d = diagnose_case(effect, 0, 1 + i as u64, 0.0);
+        // DIAG_NOISE=sigma, DIAG_VARIANT=n measure other cases (docs/results.md).
+        let env = |k: &str| std::env::var(k).ok().and_then(|v| v.parse::<f64>().ok());
+        let d = diagnose_case(
+            effect,
+            env("DIAG_VARIANT").unwrap_or(0.0) as u32,
+            1 + i as u64,
+            env("DIAG_NOISE").unwrap_or(0.0),
+        );
         let first = d.accepted.first().cloned().unwrap_or_else(|| "none".into());
         if first == *effect {
             right += 1;
@@ -65,13 +73,12 @@ fn first_accepted_effect_is_the_planted_one() {
             );
         }
     }
-    // Measured 8 (camera_response is taken for vignetting): docs/results.md.
+    // Measured 9 of 9, every ratio <= 0.16: docs/results.md.
     assert!(right >= 8, "{right} of 9 right:\n{}", lines.join("\n"));
-    ratios.sort_by(f64::total_cmp);
-    let median = ratios[ratios.len() / 2];
+    let worst = ratios.iter().copied().fold(0.0, f64::max);
     assert!(
-        median <= 0.5,
-        "median deviation after/before {median}:\n{}",
+        worst <= 0.5,
+        "deviation after/before up to {worst}:\n{}",
         lines.join("\n")
     );
 }

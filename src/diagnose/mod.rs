@@ -3,18 +3,20 @@
 //! (DESIGN.md "diagnose", docs/diagnose.md).
 //!
 //! Each round scores every applicable effect by how much of the residual
-//! its feature maps explain (`residual.rs`), then confirms each by a refit
-//! with the effect added (`library.rs`): first the effect's own parameters
-//! alone, searched over their bounds, then everything, warm-started around
-//! the result (`fit::run` with `start_radius`). An effect is accepted when
+//! its feature maps explain (`residual.rs`), then confirms each by refits
+//! with the effect added (`library.rs`): a warm one (from the best of the
+//! effect's starts, its own parameters and those it trades with searched,
+//! then everything refined around the result) and one from scratch (every
+//! parameter over its bounds), the better counting. An effect is accepted when
 //! its refit lowers the Bayesian information criterion on the pixel
 //! residuals by more than a margin, and their sum by at least `min_gain`.
 //! The fit minimises absolute differences, so the criterion takes Laplace
 //! errors: `BIC = 2N ln(SAD/N) + k ln N` (SAD: the sum of absolute
 //! differences over N channel values; k: free parameters). The
-//! comparison is against a refit of the unchanged model with the same
-//! budget, so that further convergence is not credited to an effect.
-//! Rounds repeat until nothing is accepted; `unexplained` is reported when
+//! comparison is against the unchanged model refitted the same two ways,
+//! so that neither further convergence nor a better basin is credited to
+//! an effect. An accepted model is polished (every parameter refined) before
+//! the next round. Rounds repeat until nothing is accepted; `unexplained` is reported when
 //! smooth structure remains in the residual.
 
 pub mod library;
@@ -53,6 +55,15 @@ pub struct DiagnoseConfig {
     /// fit without the effect had bent far to absorb it stay bent.
     pub polish_generations: usize,
     pub polish_radius: f64,
+    /// Generations of a refit from scratch (every parameter over its
+    /// bounds, the current values one individual of the start) of each
+    /// extended model, besides its warm refit: a fit without an effect may
+    /// sit in a basin where other parameters fake it (a response faked by
+    /// a broad specular lobe and a tilted light) that no warm start
+    /// leaves. The unchanged model gets the same restart, so that a better
+    /// basin is not credited to an effect. 0: none.
+    pub restart_generations: usize,
+    pub restart_population: usize,
     /// Effects accepted at most.
     pub max_rounds: usize,
     /// Least relative drop of the residual sum of squares to accept.
@@ -71,9 +82,11 @@ impl Default for DiagnoseConfig {
             search_population: 24,
             search_generations: 40,
             refine_generations: 40,
-            start_radius: 0.08,
+            start_radius: 0.2,
             polish_generations: 80,
             polish_radius: 0.25,
+            restart_generations: 250,
+            restart_population: 40,
             max_rounds: 3,
             min_gain: 0.05,
             bic_margin: 10.0,
@@ -172,6 +185,48 @@ struct Model {
     sad: f64,
 }
 
+impl Model {
+    /// Whichever of the two is closer to the target.
+    fn better(self, other: Model) -> Model {
+        if other.sad < self.sad {
+            other
+        } else {
+            self
+        }
+    }
+}
+
+/// Runs the refits of one diagnosis into `dir/NAME` and counts their renders.
+struct Refits<'a> {
+    renderer: &'a dyn Renderer,
+    inputs: &'a Inputs,
+    config: &'a DiagnoseConfig,
+    dir: PathBuf,
+    renders: usize,
+}
+
+impl Refits<'_> {
+    fn run(
+        &mut self,
+        scene: &Scene,
+        added: Option<(&[crate::scene::FreeParam], library::Companions)>,
+        name: &str,
+        refine: Refine,
+    ) -> Result<Model> {
+        let (scene, sad, renders, image) = refit(
+            self.renderer,
+            scene,
+            added,
+            self.inputs,
+            self.config,
+            &self.dir.join(name),
+            refine,
+        )?;
+        self.renders += renders;
+        Ok(Model { scene, sad, image })
+    }
+}
+
 /// The sum of absolute differences over the mask's channel values.
 fn sad(target: &Image, render: &Image, mask: Option<&Mask>) -> f64 {
     let (t, r) = (target.as_raw(), render.as_raw());
@@ -204,7 +259,6 @@ pub fn run(inputs: &Inputs, out: &Path, config: &DiagnoseConfig) -> Result<Diagn
     let target = &inputs.target;
     let mask = inputs.mask.as_ref();
     let n = samples(target, mask);
-    let mut renders = 0usize;
 
     let image0 = render_one(renderer.as_ref(), &inputs.scene, 0)?;
     let before = deviation(target, &image0, mask);
@@ -214,28 +268,33 @@ pub fn run(inputs: &Inputs, out: &Path, config: &DiagnoseConfig) -> Result<Diagn
         scene: inputs.scene.clone(),
         image: image0,
     };
-    let refits = out.join("refits");
 
-    // The unchanged model, refitted with the budget an effect gets.
-    let null = refit(
-        renderer.as_ref(),
-        &model.scene,
-        None,
+    let mut fits = Refits {
+        renderer: renderer.as_ref(),
         inputs,
         config,
-        &refits.join("none_0"),
+        dir: out.join("refits"),
+        renders: 0,
+    };
+    // The unchanged model, refitted the two ways an effect will be.
+    let null = fits.run(
+        &model.scene,
+        None,
+        "none_0",
         Refine::close(
             config,
             config.search_generations + config.refine_generations,
         ),
     )?;
-    renders += null.2;
-    if null.1 < model.sad {
-        model = Model {
-            scene: null.0,
-            sad: null.1,
-            image: null.3,
-        };
+    model = model.better(null);
+    if config.restart_generations > 0 {
+        let again = fits.run(
+            &model.scene,
+            None,
+            "none_0_restart",
+            Refine::restart(config),
+        )?;
+        model = model.better(again);
     }
     let refined = deviation(target, &model.image, mask);
 
@@ -256,20 +315,20 @@ pub fn run(inputs: &Inputs, out: &Path, config: &DiagnoseConfig) -> Result<Diagn
             };
             let added = ParamSpace::from_scene(&ext.scene).dim() - k0;
             let (start, count) = best_start(renderer.as_ref(), &ext, inputs)?;
-            renders += count;
-            let (scene, r, count, image) = refit(
-                renderer.as_ref(),
+            fits.renders += count;
+            let mut fitted = fits.run(
                 &start,
                 Some((&ext.added, ext.companions)),
-                inputs,
-                config,
-                &refits.join(format!("{effect}_{round}")),
+                &format!("{effect}_{round}"),
                 Refine::close(config, config.refine_generations),
             )?;
-            renders += count;
-            let dev = deviation(target, &image, mask);
-            let delta = bic(r, n, k0 + added) - bic0;
-            let gain = 1.0 - r / model.sad.max(1e-9);
+            if config.restart_generations > 0 {
+                let name = format!("{effect}_{round}_restart");
+                fitted = fitted.better(fits.run(&start, None, &name, Refine::restart(config))?);
+            }
+            let dev = deviation(target, &fitted.image, mask);
+            let delta = bic(fitted.sad, n, k0 + added) - bic0;
+            let gain = 1.0 - fitted.sad / model.sad.max(1e-9);
             tried.push((
                 Candidate {
                     effect: effect.to_string(),
@@ -281,11 +340,7 @@ pub fn run(inputs: &Inputs, out: &Path, config: &DiagnoseConfig) -> Result<Diagn
                     added_params: added,
                     accepted: false,
                 },
-                Some(Model {
-                    scene,
-                    sad: r,
-                    image,
-                }),
+                Some(fitted),
             ));
         }
         // Ranked by evidence for the report; chosen by the criterion.
@@ -320,27 +375,17 @@ pub fn run(inputs: &Inputs, out: &Path, config: &DiagnoseConfig) -> Result<Diagn
         model = m;
         if config.polish_generations > 0 {
             let name = accepted.last().expect("just accepted");
-            let polished = refit(
-                renderer.as_ref(),
+            let polished = fits.run(
                 &model.scene,
                 None,
-                inputs,
-                config,
-                &refits.join(format!("{name}_{round}_polish")),
+                &format!("{name}_{round}_polish"),
                 Refine {
                     generations: config.polish_generations,
                     radius: config.polish_radius,
                     population: config.search_population,
                 },
             )?;
-            renders += polished.2;
-            if polished.1 < model.sad {
-                model = Model {
-                    scene: polished.0,
-                    sad: polished.1,
-                    image: polished.3,
-                };
-            }
+            model = model.better(polished);
         }
     }
     let after = deviation(target, &model.image, mask);
@@ -359,7 +404,8 @@ pub fn run(inputs: &Inputs, out: &Path, config: &DiagnoseConfig) -> Result<Diagn
         params_after: space.json_values(&model.scene),
         deviation_refined: refined,
         unexplained,
-        renders,
+        // The refits, and the first render of the fitted model.
+        renders: fits.renders + 1,
         wall_seconds: started.elapsed().as_secs_f64(),
     };
     report::write(
@@ -480,6 +526,16 @@ struct Refine {
 }
 
 impl Refine {
+    /// A refit from scratch: uniform over the bounds, the current values
+    /// one individual of the start.
+    fn restart(config: &DiagnoseConfig) -> Refine {
+        Refine {
+            generations: config.restart_generations,
+            radius: 1.0,
+            population: config.restart_population,
+        }
+    }
+
     /// The short refit, close to the current values, that compares effects.
     fn close(config: &DiagnoseConfig, generations: usize) -> Refine {
         Refine {
