@@ -28,6 +28,11 @@ pub struct DiagnoseArgs {
     /// Generations of each refit (searching the effect, then refining all).
     #[arg(long, default_value_t = 80)]
     generations: usize,
+    /// Generations of each refit from scratch (population 40; 0: none, about
+    /// six times fewer renders, but effects that other parameters can fake
+    /// are then missed).
+    #[arg(long, default_value_t = 250)]
+    restart_generations: usize,
     /// Effects accepted at most.
     #[arg(long, default_value_t = 3)]
     max_effects: usize,
@@ -54,6 +59,7 @@ pub fn run(a: DiagnoseArgs) -> Result<()> {
         search_generations: a.generations / 2,
         refine_generations: a.generations - a.generations / 2,
         max_rounds: a.max_effects,
+        restart_generations: a.restart_generations,
         seed: a.seed,
         ..DiagnoseConfig::default()
     };
