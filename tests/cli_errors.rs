@@ -278,3 +278,26 @@ fn set_overrides_a_field() {
     let b = image::open(d.path().join("b.png")).unwrap().to_rgb8();
     assert_ne!(a, b, "--set should change the ball's colour");
 }
+
+#[test]
+fn non_positive_exposure_and_white_balance() {
+    let d = tempfile::tempdir().unwrap();
+    let f = write(
+        d.path(),
+        "e.json",
+        &edited(|v| v["camera"]["exposure"] = serde_json::json!(0)),
+    );
+    assert_user_error(
+        &render(d.path(), &f),
+        &["e.json", "camera.exposure", "positive"],
+    );
+    let f = write(
+        d.path(),
+        "w.json",
+        &edited(|v| v["camera"]["white_balance"] = serde_json::json!([1, -1, 1])),
+    );
+    assert_user_error(
+        &render(d.path(), &f),
+        &["w.json", "camera.white_balance", "positive"],
+    );
+}

@@ -159,6 +159,8 @@ pub struct Candidate {
     pub gain: Option<f64>,
     pub added_params: usize,
     pub accepted: bool,
+    /// Which refit counted: "warm" or "from scratch".
+    pub refit: String,
 }
 
 /// diagnosis.json (DESIGN.md keys first).
@@ -322,9 +324,14 @@ pub fn run(inputs: &Inputs, out: &Path, config: &DiagnoseConfig) -> Result<Diagn
                 &format!("{effect}_{round}"),
                 Refine::close(config, config.refine_generations),
             )?;
+            let mut refit = "warm";
             if config.restart_generations > 0 {
                 let name = format!("{effect}_{round}_restart");
-                fitted = fitted.better(fits.run(&start, None, &name, Refine::restart(config))?);
+                let again = fits.run(&start, None, &name, Refine::restart(config))?;
+                if again.sad < fitted.sad {
+                    refit = "from scratch";
+                }
+                fitted = fitted.better(again);
             }
             let dev = deviation(target, &fitted.image, mask);
             let delta = bic(fitted.sad, n, k0 + added) - bic0;
@@ -339,6 +346,7 @@ pub fn run(inputs: &Inputs, out: &Path, config: &DiagnoseConfig) -> Result<Diagn
                     gain: Some(gain),
                     added_params: added,
                     accepted: false,
+                    refit: refit.into(),
                 },
                 Some(fitted),
             ));

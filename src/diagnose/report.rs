@@ -69,11 +69,11 @@ fn html(d: &Diagnosis, scale: f64) -> String {
         "<h2>Residual (target − render)</h2><p>Red: target brighter; blue: darker; full colour = {scale:.4} linear.</p>\
          <p><img src=\"residual_before.png\" alt=\"before\"><img src=\"residual_after.png\" alt=\"after\"></p><p>before &nbsp; after</p>"
     );
-    s.push_str("<h2>Candidates, ranked by evidence within each round</h2><table><tr><th>round</th><th>effect</th><th>evidence (R²)</th><th>params added</th><th>ΔBIC</th><th>RSS drop</th><th>deviation after</th><th>accepted</th></tr>");
+    s.push_str("<h2>Candidates, ranked by evidence within each round</h2><table><tr><th>round</th><th>effect</th><th>evidence (R²)</th><th>params added</th><th>ΔBIC</th><th>SAD drop</th><th>deviation after</th><th>refit</th><th>accepted</th></tr>");
     for c in &d.candidates {
         let _ = write!(
             s,
-            "<tr><td>{}</td><td style=\"text-align:left\">{}</td><td>{:.3}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
+            "<tr><td>{}</td><td style=\"text-align:left\">{}</td><td>{:.3}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
             c.round,
             c.effect,
             c.evidence,
@@ -81,6 +81,7 @@ fn html(d: &Diagnosis, scale: f64) -> String {
             c.delta_bic.map_or("-".into(), |v| format!("{v:.1}")),
             c.gain.map_or("-".into(), |v| format!("{:.1} %", 100.0 * v)),
             c.deviation_after.map_or("-".into(), |v| format!("{:.3}", v.average)),
+            c.refit,
             if c.accepted { "yes" } else { "" }
         );
     }
