@@ -97,8 +97,7 @@ fn main() {
         let n = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
         let d = [d[0] / n, d[1] / n, d[2] / n];
         let g = dirs[i - 1];
-        let cos = (d[0] * g[0] + d[1] * g[1] + d[2] * g[2]).clamp(-1.0, 1.0);
-        let err = cos.acos().to_degrees();
+        let err = photo::angle_deg(d, g);
         errors.push(err);
         let t = std::time::Instant::now();
         let inputs = Inputs {
@@ -123,7 +122,7 @@ fn main() {
             .params_after
             .get("lights.led.direction")
             .and_then(|v| serde_json::from_value::<[f64; 3]>(v.clone()).ok())
-            .map_or(f64::NAN, |a| angle(a, g));
+            .map_or(f64::NAN, |a| photo::angle_deg(a, g));
         errors_after.push(after);
         println!(
             "| {i:03} | [{:.3}, {:.3}, {:.3}] | [{:.3}, {:.3}, {:.3}] | {err:.2} | {after:.2} | {:.3} | {:.3} | {} | {fit_s:.1} | {:.1} |",
@@ -138,19 +137,12 @@ fn main() {
     errors_after.sort_by(f64::total_cmp);
     println!(
         "median angular error after diagnose {:.2}°",
-        errors_after[errors_after.len() / 2]
+        photo::median(&errors_after)
     );
     println!(
         "\nmedian angular error {:.2}° over {} images (max {:.2}°)",
-        errors[errors.len() / 2],
+        photo::median(&errors),
         errors.len(),
         errors.last().unwrap()
     );
-}
-
-/// Degrees between two directions (not necessarily unit).
-fn angle(a: [f64; 3], b: [f64; 3]) -> f64 {
-    let n = |v: [f64; 3]| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
-    let c = (a[0] * b[0] + a[1] * b[1] + a[2] * b[2]) / (n(a) * n(b));
-    c.clamp(-1.0, 1.0).acos().to_degrees()
 }

@@ -128,9 +128,7 @@ fn main() {
             unreachable!()
         };
         let g = truth[images[j] - 1];
-        let n = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
-        let c = (v[0] * g[0] + v[1] * g[1] + v[2] * g[2]) / n;
-        let err = c.clamp(-1.0, 1.0).acos().to_degrees();
+        let err = photo::angle_deg(v, g);
         errors.push(err);
         println!("| {:03} | {err:.2} | {:.3} |", images[j], d.average);
         devs.push(d.average);
@@ -139,8 +137,8 @@ fn main() {
     devs.sort_by(f64::total_cmp);
     println!(
         "median angular error {:.2}°, median deviation {:.3} %",
-        errors[errors.len() / 2],
-        devs[devs.len() / 2]
+        photo::median(&errors),
+        photo::median(&devs)
     );
     let s = space.scene_at(&scene, &unit_for(&best, 0));
     let m = &s.objects[0].material;

@@ -36,9 +36,7 @@ fn angle(scene: &scenefit::scene::Scene, truth: [f64; 3]) -> f64 {
     else {
         panic!("no direction")
     };
-    let n = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
-    let cos = (d[0] * truth[0] + d[1] * truth[1] + d[2] * truth[2]) / n;
-    cos.clamp(-1.0, 1.0).acos().to_degrees()
+    photo::angle_deg(d, truth)
 }
 
 #[test]

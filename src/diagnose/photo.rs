@@ -53,6 +53,26 @@ pub fn reduced_mask(mask: &image::GrayImage, photo: &Image, factor: u32) -> Mask
     Mask::from_pixels(w, h, pixels)
 }
 
+/// Degrees between two directions (neither need be unit length): the
+/// angular error of a fitted light direction against a calibrated one.
+pub fn angle_deg(a: [f64; 3], b: [f64; 3]) -> f64 {
+    let n = |v: [f64; 3]| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+    let c = (a[0] * b[0] + a[1] * b[1] + a[2] * b[2]) / (n(a) * n(b)).max(1e-300);
+    c.clamp(-1.0, 1.0).acos().to_degrees()
+}
+
+/// The median (the mean of the two middle values of an even count).
+pub fn median(values: &[f64]) -> f64 {
+    let mut v = values.to_vec();
+    v.sort_by(f64::total_cmp);
+    let n = v.len();
+    match n {
+        0 => f64::NAN,
+        _ if n % 2 == 1 => v[n / 2],
+        _ => 0.5 * (v[n / 2 - 1] + v[n / 2]),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -69,5 +89,13 @@ mod tests {
         let m = reduced_mask(&mask, &photo, 2);
         assert_eq!(m.pixels(), &[0]);
         assert_eq!(downsample(&photo, 2).get_pixel(0, 0)[1], 20);
+    }
+
+    #[test]
+    fn angle_and_median() {
+        assert!((angle_deg([1.0, 0.0, 0.0], [0.0, 2.0, 0.0]) - 90.0).abs() < 1e-12);
+        assert!(angle_deg([0.0, 0.0, 1.0], [0.0, 0.0, 1.00003]) < 1e-9);
+        assert_eq!(median(&[3.0, 1.0, 2.0, 10.0]), 2.5);
+        assert_eq!(median(&[3.0, 1.0, 2.0]), 2.0);
     }
 }
