@@ -84,7 +84,7 @@ fn main() {
         }));
     }
     let shots = json!({"format": "scenefit-shots/1", "shots": shots});
-    let path = root.join("scenes/diligent_ball/shots.json");
+    let path = root.join("scenes/diligent_ball/shots_calibrated.json");
     std::fs::create_dir_all(path.parent().unwrap()).unwrap();
     let text = serde_json::to_string_pretty(&shots).unwrap() + "\n";
     scenefit::fsio::write_atomic(&path, text.as_bytes()).unwrap();

@@ -17,3 +17,4 @@ pub mod render;
 pub mod report;
 pub mod rundir;
 pub mod scene;
+pub mod shots;

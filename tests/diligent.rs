@@ -175,7 +175,7 @@ fn light_direction_of_a_photograph_within_four_degrees() {
 #[test]
 fn shots_file_names_each_photograph_its_mask_and_its_light_direction() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let shots_path = root.join("scenes/diligent_ball/shots.json");
+    let shots_path = root.join("scenes/diligent_ball/shots_calibrated.json");
     let shots: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&shots_path).unwrap()).unwrap();
     assert_eq!(shots["format"], "scenefit-shots/1");

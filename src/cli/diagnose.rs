@@ -54,7 +54,12 @@ pub fn run(a: DiagnoseArgs) -> Result<()> {
     if a.jobs == Some(0) {
         return Err(Error::Usage("--jobs: expected 1 or more".into()));
     }
-    let inputs = Inputs::from_fit_dir(&a.fit_dir, a.target.as_deref(), a.mask.as_deref())?;
+    let set = diagnose::set::SetInputs::from_fit_dir(&a.fit_dir)?;
+    if set.is_some() && (a.target.is_some() || a.mask.is_some()) {
+        return Err(Error::Usage(
+            "--target/--mask: the fit directory holds a set of photographs; each one's target and mask come from its shots.json".into(),
+        ));
+    }
     let mut config = DiagnoseConfig {
         renderer: a.renderer,
         render_options: a.render_options.options(),
@@ -69,7 +74,13 @@ pub fn run(a: DiagnoseArgs) -> Result<()> {
     if let Some(j) = a.jobs {
         config.jobs = j;
     }
-    let d = diagnose::run(&inputs, &a.output, &config)?;
+    let d = match set {
+        Some(set) => diagnose::set::run(&set, &a.output, &config)?.diagnosis,
+        None => {
+            let inputs = Inputs::from_fit_dir(&a.fit_dir, a.target.as_deref(), a.mask.as_deref())?;
+            diagnose::run(&inputs, &a.output, &config)?
+        }
+    };
     println!(
         "deviation {:.3} % -> {:.3} %; accepted: {}; {} renders in {:.1} s; results in {}",
         d.deviation_before.average,

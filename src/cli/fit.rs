@@ -2,10 +2,8 @@
 
 use super::progress::Progress;
 use super::search::{self, Search};
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::fit::{self, FitTarget};
-use crate::metric::Mask;
-use crate::raster::io as image_io;
 use crate::render::from_spec_with;
 use crate::rundir::Mode;
 use crate::scene::{load_with, Override, Scene};
@@ -14,34 +12,34 @@ use std::path::PathBuf;
 use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
 
-/// What every fitting command reads: the scene, the photograph, the mask.
+/// What every fitting command reads: the scene, the photograph, the mask
+/// (or a set of photographs, each with its own mask).
 #[derive(Args, Debug)]
 pub struct FitInputs {
     /// The scene file (JSON) with its "free" parameters.
     pub scene: PathBuf,
     /// The photograph (or rendered target) to fit, the scene's image size.
-    #[arg(long)]
-    pub target: PathBuf,
+    #[arg(long, required_unless_present = "shots")]
+    pub target: Option<PathBuf>,
     /// Pixels that count: white in an image of the same size.
-    #[arg(long)]
+    #[arg(long, conflicts_with = "shots")]
     pub mask: Option<PathBuf>,
+    /// A set of photographs of the scene (a shots file, format
+    /// scenefit-shots/1): fitted jointly, free parameters marked
+    /// "per_shot" get one value per photograph.
+    #[arg(long, conflicts_with = "target", value_name = "SHOTS.json")]
+    pub shots: Option<PathBuf>,
 }
 
 impl FitInputs {
     /// The photograph and mask, checked against the scene's image size.
     pub fn target(&self, scene: &Scene) -> Result<FitTarget> {
-        let (w, h) = (scene.image.width, scene.image.height);
-        let image = image_io::read_target(&self.target, w, h)?;
-        let mask = self
-            .mask
-            .as_ref()
-            .map(|m| Mask::load(m, w, h))
-            .transpose()?;
-        Ok(FitTarget {
-            image,
-            mask,
-            path: Some(self.target.clone()),
-        })
+        let Some(target) = &self.target else {
+            return Err(Error::Usage(
+                "--shots: this command fits one photograph; give --target".into(),
+            ));
+        };
+        FitTarget::read(target, self.mask.as_deref(), None, scene)
     }
 }
 
@@ -73,6 +71,10 @@ pub struct FitArgs {
     /// white_balance (0.5-2 per channel).
     #[arg(long, value_delimiter = ',', value_name = "NAMES")]
     nuisance: Vec<crate::scene::Nuisance>,
+    /// A set of photographs (--shots): alternations of the shared and the
+    /// per-shot blocks at most.
+    #[arg(long, default_value_t = 4, value_parser = super::positive_count)]
+    rounds: usize,
     /// No progress output.
     #[arg(long, short)]
     quiet: bool,
@@ -81,6 +83,10 @@ pub struct FitArgs {
 pub fn run(a: FitArgs) -> Result<()> {
     let mut scene = load_with(&a.inputs.scene, &a.set)?;
     crate::scene::nuisance::add(&mut scene, &a.nuisance);
+    if let Some(shots) = &a.inputs.shots {
+        let shots = crate::shots::load(shots, &scene)?;
+        return run_set(&a, &scene, &shots);
+    }
     let target = a.inputs.target(&scene)?;
     let renderer = from_spec_with(&a.renderer, &a.render_options.options())?;
     let mut config = a.search.config(renderer.default_jobs())?;
@@ -115,6 +121,53 @@ pub fn run(a: FitArgs) -> Result<()> {
             result.evaluations,
             result.wall_seconds,
             result.stop_reason,
+            a.output.display()
+        );
+    }
+    Ok(())
+}
+
+/// `fit --shots`: one fit of every photograph of a set.
+fn run_set(a: &FitArgs, scene: &Scene, shots: &[crate::shots::Shot]) -> Result<()> {
+    let renderer = from_spec_with(&a.renderer, &a.render_options.options())?;
+    let mut config = a.search.config(renderer.default_jobs())?;
+    let file = a.inputs.scene.display().to_string();
+    let (w, h) = (scene.image.width, scene.image.height);
+    let avail = crate::scene::memory::available();
+    let candidates = config.de.population * shots.len();
+    crate::scene::memory::check_fit(avail, &file, w, h, candidates, config.jobs)?;
+    config.mode = run_mode(a.resume, a.overwrite);
+    config.interrupt = Some(interrupt_flag());
+    let set = fit::set::SetConfig {
+        fit: config,
+        rounds: a.rounds,
+        warm: false,
+    };
+    let mut progress = Progress::new(a.quiet);
+    let outcome = fit::set::run(
+        scene,
+        shots,
+        renderer.as_ref(),
+        &set,
+        &a.output,
+        &mut progress,
+    )?;
+    progress.finish();
+    if !a.quiet {
+        let r = &outcome.result;
+        let worst = outcome
+            .shots
+            .iter()
+            .map(|s| s.result.deviation.average)
+            .fold(0.0, f64::max);
+        println!(
+            "{} photographs: average deviation {:.3} (worst photograph {:.3}); {} renders in {:.1} s ({}); results in {}",
+            shots.len(),
+            r.deviation.average,
+            worst,
+            r.evaluations,
+            r.wall_seconds,
+            r.stop_reason,
             a.output.display()
         );
     }

@@ -27,6 +27,7 @@ mod refit;
 pub mod report;
 pub mod residual;
 mod selection;
+pub mod set;
 mod starts;
 
 pub use config::DiagnoseConfig;

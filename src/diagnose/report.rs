@@ -1,16 +1,18 @@
 //! The files a diagnosis writes (names in `output.rs`): diagnosis.json,
 //! improved_scene.json (the extended scene with refitted values), the
 //! residual heatmaps before and after (on one scale: red, the target is
-//! brighter; blue, darker), the render after, and the HTML report.
+//! brighter; blue, darker), the render after, and the HTML report; for a
+//! set of photographs, those of every photograph, in a grid.
 
 use super::output;
 use super::residual::Residual;
+use super::set::{SetDiagnosis, SetInputs, SetModel};
 use super::Diagnosis;
 use crate::error::{Error, Result};
 use crate::fsio::write_atomic;
 use crate::metric::Deviation;
 use crate::raster::{io as image_io, Image};
-use crate::report::html::Page;
+use crate::report::html::{esc, href, Page};
 use crate::scene::Scene;
 use std::path::Path;
 
@@ -37,6 +39,69 @@ pub fn write(
     write_atomic(&out.join(output::REPORT_HTML), html(d, scale).as_bytes())
 }
 
+/// Writes every file of the set diagnosis `d` into `out`: diagnosis.json,
+/// the improved shared scene, and for every photograph its render after
+/// and its residual before and after, shown in a grid on the page.
+pub fn write_set(
+    out: &Path,
+    d: &SetDiagnosis,
+    model: &SetModel,
+    inputs: &SetInputs,
+    residuals: (&[Residual], &[Residual]),
+) -> Result<()> {
+    let (before, after) = residuals;
+    write_atomic(&out.join(output::DIAGNOSIS_JSON), json(d)?.as_bytes())?;
+    write_atomic(
+        &out.join(output::IMPROVED_SCENE),
+        json(&model.scene)?.as_bytes(),
+    )?;
+    let scale = before
+        .iter()
+        .chain(after)
+        .map(Residual::peak)
+        .fold(1e-3, f64::max);
+    for (i, s) in inputs.shots.iter().enumerate() {
+        let name = &s.name;
+        image_io::write_image(
+            &before[i].heatmap(scale),
+            &out.join(output::shot_residual_before(name)),
+        )?;
+        image_io::write_image(
+            &after[i].heatmap(scale),
+            &out.join(output::shot_residual_after(name)),
+        )?;
+        image_io::write_image(&model.images[i], &out.join(output::shot_render_after(name)))?;
+    }
+    let mut page = Page::new("scenefit diagnosis of a set of photographs");
+    summary(&mut page, &d.diagnosis);
+    page.h2("Every photograph", "shots");
+    page.p(&format!(
+        "Residual (target − render): red where the target is brighter, blue where darker; full colour = {scale:.4} linear, the same for every photograph."
+    ));
+    let mut grid = String::from("<table>\n<tr><th class=\"l\">shot</th><th>deviation before</th><th>after</th><th>residual before</th><th>residual after</th><th>render after</th></tr>\n");
+    for s in &d.shots_after {
+        let img = |f: String| {
+            format!(
+                "<td><img class=\"px\" style=\"width:192px\" src=\"{}\" alt=\"\"></td>",
+                href(&f)
+            )
+        };
+        grid.push_str(&format!(
+            "<tr><td class=\"l\">{}</td><td>{:.3}</td><td>{:.3}</td>{}{}{}</tr>\n",
+            esc(&s.name),
+            s.deviation_before.average,
+            s.deviation_after.average,
+            img(output::shot_residual_before(&s.name)),
+            img(output::shot_residual_after(&s.name)),
+            img(output::shot_render_after(&s.name)),
+        ));
+    }
+    grid.push_str("</table>");
+    page.raw(&grid);
+    candidates(&mut page, &d.diagnosis);
+    write_atomic(&out.join(output::REPORT_HTML), page.finish().as_bytes())
+}
+
 fn dev_row(name: &str, v: &Deviation) -> Vec<String> {
     let f = |x: f64| format!("{x:.3}");
     vec![name.into(), f(v.r), f(v.g), f(v.b), f(v.average)]
@@ -44,6 +109,19 @@ fn dev_row(name: &str, v: &Deviation) -> Vec<String> {
 
 fn html(d: &Diagnosis, scale: f64) -> String {
     let mut page = Page::new("scenefit diagnosis");
+    summary(&mut page, d);
+    page.h2("Residual (target − render)", "residual");
+    page.p(&format!(
+        "Red: target brighter; blue: darker; full colour = {scale:.4} linear."
+    ));
+    page.figure_enlarged(output::RESIDUAL_BEFORE, "before", 384);
+    page.figure_enlarged(output::RESIDUAL_AFTER, "after", 384);
+    candidates(&mut page, d);
+    page.finish()
+}
+
+/// The verdict and the deviations before, refitted and after.
+fn summary(page: &mut Page, d: &Diagnosis) {
     let acc = if d.accepted.is_empty() {
         "none".to_string()
     } else {
@@ -60,12 +138,10 @@ fn html(d: &Diagnosis, scale: f64) -> String {
             dev_row("after", &d.deviation_after),
         ],
     );
-    page.h2("Residual (target − render)", "residual");
-    page.p(&format!(
-        "Red: target brighter; blue: darker; full colour = {scale:.4} linear."
-    ));
-    page.figure_enlarged(output::RESIDUAL_BEFORE, "before", 384);
-    page.figure_enlarged(output::RESIDUAL_AFTER, "after", 384);
+}
+
+/// The candidates of every round and the parameters after.
+fn candidates(page: &mut Page, d: &Diagnosis) {
     page.h2(
         "Candidates, ranked by evidence within each round",
         "candidates",
@@ -91,7 +167,6 @@ fn html(d: &Diagnosis, scale: f64) -> String {
         .map(|(k, v)| vec![k.clone(), v.to_string()])
         .collect();
     page.table(&["parameter", "value"], &params);
-    page.finish()
 }
 
 fn candidate_row(c: &super::Candidate) -> Vec<String> {

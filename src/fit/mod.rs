@@ -10,20 +10,23 @@
 
 mod checkpoint;
 mod executor;
-mod identity;
+pub(crate) mod identity;
 mod observers;
 mod output;
 mod problem;
+pub mod set;
+mod target;
 mod uncertainty;
 
 pub use checkpoint::Checkpoint;
 pub use executor::{Observer, Problem};
 pub use output::{FitOutcome, FitResult, Population};
 pub use problem::render_seed;
+pub use target::FitTarget;
 pub use uncertainty::{Correlation, Uncertainty};
 
 use crate::error::{Error, Result};
-use crate::metric::{deviation, Deviation, Mask};
+use crate::metric::{deviation, Deviation};
 use crate::optimize::{DeConfig, Search, Searcher, Start, StopReason, StopRule};
 use crate::raster::Image;
 use crate::render::Renderer;
@@ -82,15 +85,6 @@ impl Default for FitConfig {
             inputs: Vec::new(),
         }
     }
-}
-
-/// What the fit compares against.
-#[derive(Clone, Debug)]
-pub struct FitTarget {
-    pub image: Image,
-    pub mask: Option<Mask>,
-    /// For result.json.
-    pub path: Option<PathBuf>,
 }
 
 /// A generation's news, for progress displays and logs.
@@ -351,6 +345,7 @@ fn finish(
         identifiability: search
             .identifiability()
             .map(|id| uncertainty::of(&sub, &id)),
+        shots: None,
     };
     result.check_finite()?;
     state.search = Some(search);

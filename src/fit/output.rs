@@ -29,6 +29,10 @@ pub struct FitResult {
     /// Jacobian (the `hybrid` strategy); absent for a population search.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub identifiability: Option<super::uncertainty::Uncertainty>,
+    /// A set of photographs (`fit --shots`): each one's own parameters and
+    /// deviation; `params` then holds the shared ones.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shots: Option<Vec<super::set::ShotResult>>,
 }
 
 impl FitResult {

@@ -38,6 +38,21 @@ impl Deviation {
         }
     }
 
+    /// The deviation over several images together, each given with the
+    /// number of pixels it counts: every counted pixel weighs the same.
+    pub fn pooled(parts: &[(Deviation, usize)]) -> Deviation {
+        let total: usize = parts.iter().map(|(_, n)| n).sum();
+        let w = |n: usize| n as f64 / total.max(1) as f64;
+        let sum = |f: fn(&Deviation) -> f64| parts.iter().map(|(d, n)| f(d) * w(*n)).sum::<f64>();
+        let (r, g, b) = (sum(|d| d.r), sum(|d| d.g), sum(|d| d.b));
+        Deviation {
+            r,
+            g,
+            b,
+            average: (r + g + b) / 3.0,
+        }
+    }
+
     /// What the optimizer minimises.
     pub fn fitness(&self) -> f64 {
         self.r + self.g + self.b

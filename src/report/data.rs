@@ -183,6 +183,7 @@ mod tests {
             target: None,
             failed_renders: 0,
             identifiability: None,
+            shots: None,
         };
         let c = read_progress(&p, &result).unwrap();
         assert_eq!(c.len(), 2);

@@ -36,6 +36,10 @@ pub const FAILURES: &str = "failures.log";
 /// trace.tsv: one line per generation with its time (the report's axis).
 pub const TRACE: &str = "trace.tsv";
 /// A pipeline's copy of the target, and of the mask when one was given.
+/// A set fit's state between blocks (see `fit::set`).
+pub const SET_STATE: &str = "set_state.json";
+/// A set fit's photographs, with absolute paths.
+pub const SHOTS: &str = "shots.json";
 pub const TARGET: &str = "target.png";
 pub const MASK: &str = "mask.png";
 /// A pipeline's stage 2: the scene handed over, and its first render.
@@ -53,6 +57,11 @@ pub const STAGE2: &str = "stage2";
 const LOCK: &str = ".scenefit.lock";
 
 /// best_gNNNN.bmp: the best image at a generation, as the paper saved them.
+/// The best render of one photograph of a set.
+pub fn shot_best_name(shot: &str) -> String {
+    format!("best_{shot}.png")
+}
+
 pub fn snapshot_name(generation: usize) -> String {
     format!("best_g{generation:04}.bmp")
 }

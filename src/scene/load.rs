@@ -94,6 +94,23 @@ pub fn parse(text: &str, file: &str, overrides: &[Override]) -> Result<Scene> {
     from_value(value, file)
 }
 
+/// `scene` with `overrides` applied (as `--set` would), validated again;
+/// `file` and `at` name where the overrides came from in messages.
+pub fn with_overrides(
+    scene: &Scene,
+    overrides: &[Override],
+    file: &str,
+    at: &str,
+) -> Result<Scene> {
+    let mut value = serde_json::to_value(scene)
+        .map_err(|e| Error::Run(format!("cannot serialise the scene: {e}")))?;
+    for o in overrides {
+        apply_override(&mut value, o)
+            .map_err(|m| Error::invalid(file, format!("{at}.{}", o.path), m))?;
+    }
+    from_value(value, file)
+}
+
 /// Types and validates a JSON value.
 pub fn from_value(value: serde_json::Value, file: &str) -> Result<Scene> {
     if !value.is_object() {

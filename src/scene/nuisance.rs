@@ -43,6 +43,7 @@ pub fn add(scene: &mut Scene, which: &[Nuisance]) {
             max,
             space: Default::default(),
             phase: None,
+            per_shot: false,
         });
     }
 }

@@ -17,6 +17,8 @@ pub struct ParamSpec {
     pub max: Vec<f64>,
     pub hsv: bool,
     pub phase: u32,
+    /// Each photograph of a set has its own value (see `FreeParam`).
+    pub per_shot: bool,
 }
 
 impl ParamSpec {
@@ -91,6 +93,7 @@ impl ParamSpace {
                     max,
                     hsv,
                     phase: f.phase.unwrap_or(1),
+                    per_shot: f.per_shot,
                 })
             })
             .collect();
@@ -115,13 +118,23 @@ impl ParamSpace {
 
     /// The sub-space of one phase.
     pub fn phase(&self, phase: u32) -> ParamSpace {
+        self.filtered(|s| s.phase == phase)
+    }
+
+    /// The parameters shared by every photograph of a set (`per_shot` false).
+    pub fn shared(&self) -> ParamSpace {
+        self.filtered(|s| !s.per_shot)
+    }
+
+    /// The parameters each photograph of a set has its own value of.
+    pub fn per_shot(&self) -> ParamSpace {
+        self.filtered(|s| s.per_shot)
+    }
+
+    /// The sub-space of the parameters `keep` accepts, in order.
+    pub fn filtered(&self, keep: impl Fn(&ParamSpec) -> bool) -> ParamSpace {
         ParamSpace {
-            specs: self
-                .specs
-                .iter()
-                .filter(|s| s.phase == phase)
-                .cloned()
-                .collect(),
+            specs: self.specs.iter().filter(|s| keep(s)).cloned().collect(),
         }
     }
 

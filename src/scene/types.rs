@@ -325,6 +325,14 @@ pub struct FreeParam {
     pub space: ColorSpace,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub phase: Option<u32>,
+    /// In a set of photographs (`fit --shots`), each photograph gets its
+    /// own value; every other free parameter is shared by all of them.
+    #[serde(default, skip_serializing_if = "is_false")]
+    pub per_shot: bool,
+}
+
+fn is_false(b: &bool) -> bool {
+    !*b
 }
 
 fn is_rgb(space: &ColorSpace) -> bool {

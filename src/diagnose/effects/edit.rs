@@ -14,6 +14,7 @@ pub fn free(scene: &Scene, field: Field, min: Bound, max: Bound) -> FreeParam {
         max,
         space: Default::default(),
         phase: None,
+        per_shot: false,
     }
 }
 

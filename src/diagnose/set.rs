@@ -1,0 +1,368 @@
+//! `diagnose` of a set fit (`fit --shots`): the same rounds as for one
+//! photograph, with the evidence pooled over every photograph (each one's
+//! R² weighted by its pixels) and every refit a set fit (the shared
+//! parameters over all photographs, each photograph's own after them), so
+//! that an effect is accepted on the set: an effect shared by every
+//! photograph is weak evidence in one and strong across twenty.
+//!
+//! A refit here is warm: each photograph keeps its fitted own values as
+//! the start of its own block, and the shared block searches the whole box
+//! with the current values one member of its population (this is what the
+//! one-photograph diagnosis gets from its starts and from-scratch refits).
+
+use super::effects::{self, Effect};
+use super::residual::Residual;
+use super::selection::{bic, choose, sad, samples};
+use super::{Candidate, DiagnoseConfig, Diagnosis, UNEXPLAINED};
+use crate::error::{Error, Result};
+use crate::fit::set::{self as setfit, SetConfig};
+use crate::fit::{FitConfig, FitResult};
+use crate::metric::{deviation, Deviation};
+use crate::optimize::{DeConfig, Strategy};
+use crate::raster::Image;
+use crate::render::{from_spec_with, Renderer};
+use crate::rundir::{RunDir, FITTED_SCENE, SHOTS};
+use crate::scene::load::with_overrides;
+use crate::scene::{Override, ParamSpace, Scene};
+use crate::shots::Shot;
+use serde::Serialize;
+use std::path::Path;
+use std::time::Instant;
+
+type Params = serde_json::Map<String, serde_json::Value>;
+
+/// A set fit's outputs, as a diagnosis starts from them.
+pub struct SetInputs {
+    /// The shared model.
+    pub scene: Scene,
+    pub shots: Vec<Shot>,
+    /// Each photograph's own fitted values.
+    pub own: Vec<Params>,
+}
+
+impl SetInputs {
+    /// The set fit in `dir`, or None when `dir` holds a fit of one photograph.
+    pub fn from_fit_dir(dir: &Path) -> Result<Option<SetInputs>> {
+        if !dir.join(crate::rundir::RESULT).is_file() {
+            return Ok(None); // the one-photograph path says what is missing
+        }
+        let run = RunDir::existing(dir)?;
+        let result = FitResult::load(&run)?;
+        let Some(results) = result.shots else {
+            return Ok(None);
+        };
+        let scene = crate::scene::load(&dir.join(FITTED_SCENE))?;
+        let shots = crate::shots::load(&dir.join(SHOTS), &scene)?;
+        let own = shots
+            .iter()
+            .map(|s| {
+                results
+                    .iter()
+                    .find(|r| r.name == s.name)
+                    .map(|r| r.params.clone())
+                    .ok_or_else(|| {
+                        Error::invalid(
+                            run.file(crate::rundir::RESULT).display().to_string(),
+                            "shots",
+                            format!("expected a result for shot {}", s.name),
+                        )
+                    })
+            })
+            .collect::<Result<Vec<_>>>()?;
+        Ok(Some(SetInputs { scene, shots, own }))
+    }
+}
+
+/// One photograph after the diagnosis (diagnosis.json's `shots_after`).
+#[derive(Clone, Debug, Serialize)]
+pub struct ShotAfter {
+    pub name: String,
+    pub params: Params,
+    pub deviation_before: Deviation,
+    pub deviation_after: Deviation,
+}
+
+/// diagnosis.json of a set.
+#[derive(Clone, Debug, Serialize)]
+pub struct SetDiagnosis {
+    #[serde(flatten)]
+    pub diagnosis: Diagnosis,
+    pub shots_after: Vec<ShotAfter>,
+}
+
+/// A model of the whole set: the shared scene, each photograph's own
+/// values, its renders, and the sum of absolute differences over all.
+#[derive(Clone)]
+pub struct SetModel {
+    pub scene: Scene,
+    pub own: Vec<Params>,
+    pub images: Vec<Image>,
+    pub sad: f64,
+}
+
+impl SetModel {
+    fn better(self, other: SetModel) -> SetModel {
+        if other.sad < self.sad {
+            other
+        } else {
+            self
+        }
+    }
+
+    /// Free coordinates: the shared ones and every photograph's own.
+    fn dim(&self, inputs: &SetInputs) -> usize {
+        let space = ParamSpace::from_scene(&self.scene);
+        space.shared().dim()
+            + inputs
+                .shots
+                .iter()
+                .map(|s| s.own_space(&space).dim())
+                .sum::<usize>()
+    }
+
+    fn deviations(&self, inputs: &SetInputs) -> Vec<Deviation> {
+        self.images
+            .iter()
+            .zip(&inputs.shots)
+            .map(|(img, s)| deviation(&s.target.image, img, s.target.mask.as_ref()))
+            .collect()
+    }
+
+    fn residuals(&self, inputs: &SetInputs) -> Vec<Residual> {
+        self.images
+            .iter()
+            .zip(&inputs.shots)
+            .map(|(img, s)| Residual::new(&s.target.image, img, s.target.mask.as_ref()))
+            .collect()
+    }
+}
+
+/// Each photograph as a shot of `scene`: its `set` values and then its
+/// own values `own` in place.
+fn shots_of(scene: &Scene, inputs: &SetInputs, own: &[Params]) -> Result<Vec<Shot>> {
+    inputs
+        .shots
+        .iter()
+        .zip(own)
+        .map(|(s, own)| {
+            let overrides: Vec<Override> = s
+                .entry
+                .set
+                .iter()
+                .chain(own.iter())
+                .map(|(k, v)| Override {
+                    path: k.clone(),
+                    value: v.clone(),
+                })
+                .collect();
+            let scene = with_overrides(scene, &overrides, "(diagnosis)", &s.name)?;
+            Ok(Shot { scene, ..s.clone() })
+        })
+        .collect()
+}
+
+/// Runs the refits of a set diagnosis and counts their renders.
+struct SetRefits<'a> {
+    renderer: &'a dyn Renderer,
+    inputs: &'a SetInputs,
+    config: &'a DiagnoseConfig,
+    renders: usize,
+}
+
+impl SetRefits<'_> {
+    /// `scene` (with `own` values) refitted over the set.
+    fn run(&mut self, scene: &Scene, own: &[Params]) -> Result<SetModel> {
+        let shots = shots_of(scene, self.inputs, own)?;
+        let c = self.config;
+        let config = SetConfig {
+            fit: FitConfig {
+                generations: c
+                    .restart_generations
+                    .max(c.search_generations + c.refine_generations),
+                de: DeConfig {
+                    population: c.restart_population,
+                    seed: c.seed,
+                    strategy: Strategy::Hybrid,
+                    ..DeConfig::default()
+                },
+                jobs: c.jobs,
+                snapshot_every: usize::MAX / 2,
+                ..FitConfig::default()
+            },
+            rounds: 1,
+            warm: true,
+        };
+        let out = setfit::run_in(scene, &shots, self.renderer, &config, None, &mut ())?;
+        self.renders += out.result.evaluations + shots.len();
+        let mut sum = 0.0;
+        for (o, s) in out.shots.iter().zip(&self.inputs.shots) {
+            sum += sad(&s.target.image, &o.image, s.target.mask.as_ref());
+        }
+        Ok(SetModel {
+            scene: out.scene,
+            own: out.shots.iter().map(|o| o.result.params.clone()).collect(),
+            images: out.shots.into_iter().map(|o| o.image).collect(),
+            sad: sum,
+        })
+    }
+}
+
+/// The renders of the fitted model as it stands.
+fn initial(renderer: &dyn Renderer, inputs: &SetInputs, jobs: usize) -> Result<SetModel> {
+    let shots = shots_of(&inputs.scene, inputs, &inputs.own)?;
+    let scenes: Vec<Scene> = shots.iter().map(|s| s.scene.clone()).collect();
+    let mut session = renderer.session(&scenes[0], &ParamSpace::from_scene(&scenes[0]), jobs)?;
+    let mut images = Vec::with_capacity(scenes.len());
+    let mut total = 0.0;
+    for (r, s) in session.render_batch(&scenes, 0).into_iter().zip(&shots) {
+        let img = r.map_err(|f| {
+            Error::Run(format!(
+                "{}: render of shot {} failed: {f}",
+                renderer.name(),
+                s.name
+            ))
+        })?;
+        if img.dimensions() != s.target.image.dimensions() {
+            return Err(Error::Run(format!(
+                "{}: the render of shot {} has the wrong size",
+                renderer.name(),
+                s.name
+            )));
+        }
+        total += sad(&s.target.image, &img, s.target.mask.as_ref());
+        images.push(img);
+    }
+    Ok(SetModel {
+        scene: inputs.scene.clone(),
+        own: inputs.own.clone(),
+        images,
+        sad: total,
+    })
+}
+
+/// Pooled evidence: each photograph's R² weighted by its pixels.
+fn evidence(residuals: &[Residual], effect: &dyn Effect) -> f64 {
+    let total: usize = residuals.iter().map(|r| r.pixels.len()).sum();
+    residuals
+        .iter()
+        .map(|r| r.evidence(effect) * r.pixels.len() as f64)
+        .sum::<f64>()
+        / total.max(1) as f64
+}
+
+/// Runs the diagnosis of a set, writing its files into `out`.
+pub fn run(inputs: &SetInputs, out: &Path, config: &DiagnoseConfig) -> Result<SetDiagnosis> {
+    let started = Instant::now();
+    std::fs::create_dir_all(out).map_err(|e| Error::io(out, e))?;
+    let renderer = from_spec_with(&config.renderer, &config.render_options)?;
+    let model0 = initial(renderer.as_ref(), inputs, config.jobs)?;
+    let before = model0.deviations(inputs);
+    let residuals_before = model0.residuals(inputs);
+    let mut fits = SetRefits {
+        renderer: renderer.as_ref(),
+        inputs,
+        config,
+        renders: inputs.shots.len(),
+    };
+    let null = fits.run(&model0.scene, &model0.own)?;
+    let mut model = model0.clone().better(null);
+    let refined = pooled(&model.deviations(inputs), inputs);
+    let n: f64 = inputs
+        .shots
+        .iter()
+        .map(|s| samples(&s.target.image, s.target.mask.as_ref()))
+        .sum();
+    let mut candidates = Vec::new();
+    let mut accepted: Vec<String> = Vec::new();
+    for round in 1..=config.max_rounds {
+        let residuals = model.residuals(inputs);
+        let k0 = model.dim(inputs);
+        let mut tried: Vec<(Candidate, SetModel)> = Vec::new();
+        for &effect in effects::ALL {
+            if accepted.iter().any(|a| a == effect.name()) {
+                continue;
+            }
+            let Some(ext) = effects::extend(effect, &model.scene) else {
+                continue;
+            };
+            let fitted = fits.run(&ext.scene, &model.own)?;
+            let k = fitted.dim(inputs);
+            let candidate = Candidate {
+                effect: effect.name().to_string(),
+                evidence: evidence(&residuals, effect),
+                deviation_after: Some(pooled(&fitted.deviations(inputs), inputs)),
+                round,
+                delta_bic: Some(bic(fitted.sad, n, k) - bic(model.sad, n, k0)),
+                gain: Some(1.0 - fitted.sad / model.sad.max(1e-9)),
+                added_params: k.saturating_sub(k0),
+                accepted: false,
+                refit: "warm (set)".into(),
+            };
+            tried.push((candidate, fitted));
+        }
+        tried.sort_by(|a, b| b.0.evidence.total_cmp(&a.0.evidence));
+        let (mut found, models): (Vec<Candidate>, Vec<SetModel>) = tried.into_iter().unzip();
+        let chosen = choose(&found, config);
+        if let Some(i) = chosen {
+            found[i].accepted = true;
+            accepted.push(found[i].effect.clone());
+            model = models.into_iter().nth(i).expect("chosen from these");
+        }
+        candidates.extend(found);
+        if chosen.is_none() {
+            break;
+        }
+    }
+    let residuals_after = model.residuals(inputs);
+    let structured = residuals_after.iter().filter(|r| r.structured()).count();
+    let unexplained = 2 * structured > residuals_after.len();
+    if unexplained {
+        accepted.push(UNEXPLAINED.into());
+    }
+    let after = model.deviations(inputs);
+    let space = ParamSpace::from_scene(&model.scene);
+    let diagnosis = Diagnosis {
+        deviation_before: pooled(&before, inputs),
+        deviation_after: pooled(&after, inputs),
+        candidates,
+        accepted,
+        params_after: space.shared().json_values(&model.scene),
+        deviation_refined: refined,
+        unexplained,
+        renders: fits.renders,
+        wall_seconds: started.elapsed().as_secs_f64(),
+    };
+    let shots_after = inputs
+        .shots
+        .iter()
+        .enumerate()
+        .map(|(i, s)| ShotAfter {
+            name: s.name.clone(),
+            params: model.own[i].clone(),
+            deviation_before: before[i],
+            deviation_after: after[i],
+        })
+        .collect();
+    let d = SetDiagnosis {
+        diagnosis,
+        shots_after,
+    };
+    super::report::write_set(
+        out,
+        &d,
+        &model,
+        inputs,
+        (&residuals_before, &residuals_after),
+    )?;
+    Ok(d)
+}
+
+/// The deviation over every photograph.
+fn pooled(devs: &[Deviation], inputs: &SetInputs) -> Deviation {
+    let parts: Vec<(Deviation, usize)> = devs
+        .iter()
+        .zip(&inputs.shots)
+        .map(|(d, s)| (*d, crate::fit::set::counted(&s.target)))
+        .collect();
+    Deviation::pooled(&parts)
+}

@@ -1,0 +1,376 @@
+//! A fit of a set of photographs of one scene (`fit --shots`): the shared
+//! parameters (material, camera, …) and every photograph's own
+//! (`"per_shot": true`, e.g. its light) found by block coordinate descent.
+//!
+//! One search over all coordinates at once does not scale: 24 photographs
+//! with 4 own coordinates each make ~100 coordinates, where DE needs a
+//! budget that grows with the dimension, and most pairs of coordinates do
+//! not interact (one photograph's light does not change another's image).
+//! So the blocks alternate:
+//! 1. each photograph's own parameters, the shared ones held (independent
+//!    small fits, one per photograph);
+//! 2. the shared parameters, every photograph's own held: one search whose
+//!    candidate is drawn once per photograph and scored over all of them
+//!    (`problem`);
+//!
+//! and again 1, 2, … until a round improves the deviation over the whole
+//! set by less than 1 %, or the round budget is spent. Later blocks start
+//! around the current values. The state is saved after every block
+//! (`state`), so `--resume` continues from the last finished block.
+
+mod outcome;
+mod problem;
+mod state;
+
+pub use outcome::{SetOutcome, ShotOutcome, ShotResult};
+pub use problem::counted;
+
+use super::executor::{Executor, Halt, Offsets};
+use super::{FitConfig, Observer};
+use crate::error::{Error, Result};
+use crate::optimize::{Search, Searcher, Start, StopRule};
+use crate::render::Renderer;
+use crate::rundir::{Mode, RunDir};
+use crate::scene::{Field, ParamSpace, ParamSpec, Scene};
+use crate::shots::Shot;
+use problem::SetProblem;
+use state::SetState;
+use std::path::Path;
+use std::time::Instant;
+
+/// How a set fit runs: each block as `fit` (search options, budget per
+/// block), and how many rounds at most.
+#[derive(Clone, Debug)]
+pub struct SetConfig {
+    pub fit: FitConfig,
+    /// Shared blocks at most (each followed by a per-shot block).
+    pub rounds: usize,
+    /// Every photograph's own values are already fitted (a refit): skip
+    /// the first per-shot block and start every per-shot block around them.
+    pub warm: bool,
+}
+
+/// Relative improvement of a round below which the blocks stop.
+const ROUND_TOLERANCE: f64 = 0.01;
+/// Unit-cube spread of a later block's start around the current values.
+const LATER_RADIUS: f64 = 0.1;
+/// Generations without improvement that end a block when `--stagnation`
+/// is not given: a block is one step of an alternation, not the last word.
+const BLOCK_STAGNATION: usize = 30;
+
+/// A block's search options: the run's, with a population of ten per
+/// coordinate (DE's usual rule; at least 16, at most the run's) and a
+/// stagnation stop.
+fn block_config(config: &FitConfig, dim: usize, seed: u64) -> FitConfig {
+    let mut c = config.clone();
+    c.de.seed = seed;
+    c.de.population = (10 * dim).clamp(16, config.de.population.max(16));
+    c.stagnation = Some(config.stagnation.unwrap_or(BLOCK_STAGNATION));
+    c.phase_generations = None;
+    c
+}
+
+/// Runs a set fit in the run directory `dir` (opened in the fit's mode).
+pub fn run(
+    scene: &Scene,
+    shots: &[Shot],
+    renderer: &dyn Renderer,
+    config: &SetConfig,
+    dir: &Path,
+    observer: &mut dyn Observer,
+) -> Result<SetOutcome> {
+    let run_dir = RunDir::open(dir, config.fit.mode)?;
+    for s in shots {
+        run_dir.refuse_overwritten_input(&s.entry.target, &format!("shot {}'s target", s.name))?;
+        if let Some(m) = &s.entry.mask {
+            run_dir.refuse_overwritten_input(m, &format!("shot {}'s mask", s.name))?;
+        }
+    }
+    run_in(scene, shots, renderer, config, Some(&run_dir), observer)
+}
+
+/// Runs a set fit, in a run directory or (None) in memory only.
+pub fn run_in(
+    scene: &Scene,
+    shots: &[Shot],
+    renderer: &dyn Renderer,
+    config: &SetConfig,
+    dir: Option<&RunDir>,
+    observer: &mut dyn Observer,
+) -> Result<SetOutcome> {
+    let space = check_inputs(scene, shots, config)?;
+    let mut state = match (dir, config.fit.mode) {
+        (Some(d), Mode::Resume) => SetState::resume(d, scene, shots, renderer, config, &space)?,
+        _ => SetState::start(scene, shots, renderer, config, &space),
+    };
+    let plan = plan(&space, shots, config.rounds, config.warm);
+    let started = Instant::now();
+    let before = state.seconds;
+    let mut cleared = config.fit.mode != Mode::Overwrite;
+    while state.blocks_done < plan.len() {
+        let block = plan[state.blocks_done];
+        let mut clear = || -> Result<()> {
+            if !cleared {
+                if let Some(d) = dir {
+                    d.clear()?;
+                }
+                cleared = true;
+            }
+            Ok(())
+        };
+        let total = match block {
+            Block::Own => own_block(&mut state, shots, renderer, config, &space, &mut clear)?,
+            Block::Shared => shared_block(
+                &mut state, shots, renderer, config, &space, observer, dir, &mut clear,
+            )?,
+        };
+        state.history.push(total);
+        state.blocks_done += 1;
+        if block == Block::Own && converged(&state.history) {
+            state.blocks_done = plan.len();
+        }
+        state.seconds = before + started.elapsed().as_secs_f64();
+        if let Some(d) = dir {
+            state.save(d)?;
+        }
+    }
+    outcome::finish(&state, scene, shots, renderer, config, &space, dir)
+}
+
+/// A step of the alternation.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Block {
+    Own,
+    Shared,
+}
+
+/// The blocks in order: own, shared, own, shared, own, … (`rounds` shared
+/// blocks), leaving out a kind of block that has no parameters.
+fn plan(space: &ParamSpace, shots: &[Shot], rounds: usize, warm: bool) -> Vec<Block> {
+    let has_own = shots.iter().any(|s| !s.own_space(space).is_empty());
+    let has_shared = !space.shared().is_empty();
+    match (has_own, has_shared) {
+        (true, true) => {
+            let mut v = if warm { vec![] } else { vec![Block::Own] };
+            for _ in 0..rounds.max(1) {
+                v.extend([Block::Shared, Block::Own]);
+            }
+            v
+        }
+        (true, false) => vec![Block::Own],
+        _ => vec![Block::Shared],
+    }
+}
+
+/// True when the last round (shared then own block) improved the set's
+/// deviation by less than `ROUND_TOLERANCE` of it.
+fn converged(history: &[f64]) -> bool {
+    let n = history.len();
+    n >= 3 && history[n - 3] - history[n - 1] < ROUND_TOLERANCE * history[n - 3]
+}
+
+/// What a set fit needs before anything starts; the scene's free space.
+fn check_inputs(scene: &Scene, shots: &[Shot], config: &SetConfig) -> Result<ParamSpace> {
+    let space = ParamSpace::from_scene(scene);
+    if space.is_empty() {
+        return Err(Error::Usage(
+            "the scene has no \"free\" parameters to fit".into(),
+        ));
+    }
+    for s in shots {
+        let (w, h) = s.target.image.dimensions();
+        if (w, h) != (scene.image.width, scene.image.height) {
+            return Err(Error::Usage(format!(
+                "shot {}: the target is {w}x{h} but the scene renders {}x{}",
+                s.name, scene.image.width, scene.image.height
+            )));
+        }
+    }
+    config
+        .fit
+        .de
+        .validate()
+        .map_err(|e| Error::Usage(e.to_string()))?;
+    Ok(space)
+}
+
+/// Every field a set's renders vary: the free parameters and the fields
+/// the shots' `set` fixes, with bounds that hold every shot's value (a
+/// renderer prepares for the range it will be asked to draw).
+fn varying(space: &ParamSpace, shots: &[Shot]) -> ParamSpace {
+    let mut specs = space.specs.clone();
+    for s in shots {
+        for key in s.entry.set.keys() {
+            if specs.iter().any(|p| &p.name == key) {
+                continue;
+            }
+            let Ok(field) = Field::resolve(&s.scene, key) else {
+                continue;
+            };
+            let values: Vec<Vec<f64>> = shots
+                .iter()
+                .filter_map(|o| field.get(&o.scene).map(|v| v.components()))
+                .collect();
+            let n = values.first().map_or(0, Vec::len);
+            let fold = |f: fn(f64, f64) -> f64, init: f64| -> Vec<f64> {
+                (0..n)
+                    .map(|c| values.iter().map(|v| v[c]).fold(init, f))
+                    .collect()
+            };
+            specs.push(ParamSpec {
+                name: key.clone(),
+                field,
+                min: fold(f64::min, f64::INFINITY),
+                max: fold(f64::max, f64::NEG_INFINITY),
+                hsv: false,
+                phase: 1,
+                per_shot: true,
+            });
+        }
+    }
+    ParamSpace { specs }
+}
+
+/// The seed of block `block` (and photograph `shot` within it): each has
+/// its own stream of the run's seed.
+fn block_seed(seed: u64, block: usize, shot: usize) -> u64 {
+    seed.wrapping_add((block as u64 + 1).wrapping_mul(0x9E37_79B9_7F4A_7C15))
+        .wrapping_add((shot as u64).wrapping_mul(0xBF58_476D_1CE4_E5B9))
+}
+
+/// Fits each photograph's own parameters with the shared ones held; the
+/// set's deviation after it.
+fn own_block(
+    state: &mut SetState,
+    shots: &[Shot],
+    renderer: &dyn Renderer,
+    config: &SetConfig,
+    space: &ParamSpace,
+    clear: &mut dyn FnMut() -> Result<()>,
+) -> Result<f64> {
+    let shared = space.shared();
+    let mut parts = Vec::with_capacity(shots.len());
+    for (i, shot) in shots.iter().enumerate() {
+        let own = shot.own_space(space);
+        let base = state.shot_scene(i, shot, &shared, &own);
+        if own.is_empty() {
+            let img = crate::render::render_one(renderer, &base, 0)?;
+            clear()?;
+            let t = &shot.target;
+            parts.push((
+                crate::metric::deviation(&t.image, &img, t.mask.as_ref()),
+                problem::counted(t),
+            ));
+            continue;
+        }
+        let mut fit_scene = base.clone();
+        fit_scene
+            .free
+            .retain(|f| own.specs.iter().any(|s| s.name == f.param));
+        let seed = block_seed(config.fit.de.seed, state.blocks_done, i);
+        let mut cfg = block_config(&config.fit, own.dim(), seed);
+        cfg.start_radius = (state.blocks_done > 0 || config.warm).then_some(LATER_RADIUS);
+        let out = super::run_in_memory(&fit_scene, &shot.target, renderer, &cfg, &mut ())?;
+        clear()?;
+        state.own[i] = own.unit_of(&out.scene);
+        state.evaluations += out.result.evaluations;
+        state.generations += out.result.generations;
+        state.failed_renders += out.result.failed_renders;
+        parts.push((out.result.deviation, problem::counted(&shot.target)));
+    }
+    Ok(crate::metric::Deviation::pooled(&parts).average)
+}
+
+/// Fits the shared parameters over every photograph at once, each with its
+/// own values held; the set's deviation after it.
+#[allow(clippy::too_many_arguments)]
+fn shared_block(
+    state: &mut SetState,
+    shots: &[Shot],
+    renderer: &dyn Renderer,
+    config: &SetConfig,
+    space: &ParamSpace,
+    observer: &mut dyn Observer,
+    dir: Option<&RunDir>,
+    clear: &mut dyn FnMut() -> Result<()>,
+) -> Result<f64> {
+    let shared = space.shared();
+    let bases: Vec<Scene> = shots
+        .iter()
+        .enumerate()
+        .map(|(i, s)| {
+            let own = s.own_space(space);
+            own.scene_at(&s.scene, &state.own[i])
+        })
+        .collect();
+    let mut session = renderer.session(&bases[0], &varying(space, shots), config.fit.jobs)?;
+    clear()?;
+    let targets = shots.iter().map(|s| &s.target).collect();
+    let seed = block_seed(config.fit.de.seed, state.blocks_done, 0);
+    let mut problem = SetProblem::new(session.as_mut(), shared.clone(), bases, targets, seed);
+    let cfg = block_config(&config.fit, shared.dim(), seed);
+    // The first shared block searches the whole box (the current values one
+    // member of its population): a shared effect such as a camera response
+    // may sit far from where the photographs' own fits left it.
+    let start = if state.shared_blocks == 0 {
+        Start::Around {
+            center: &state.shared,
+            radius: 1.0,
+        }
+    } else {
+        Start::Around {
+            center: &state.shared,
+            radius: LATER_RADIUS,
+        }
+    };
+    let mut search = Searcher::new(shared.dim(), &cfg.de, start);
+    let mut executor = Executor {
+        rule: StopRule {
+            max_generations: cfg.generations,
+            target: cfg.target_deviation.map(|d| 3.0 * d),
+            stagnation: cfg.stagnation,
+        },
+        interrupt: config.fit.interrupt.clone(),
+        observers: vec![observer],
+    };
+    let offsets = Offsets {
+        generations: state.generations,
+        evaluations: state.evaluations,
+        seconds: state.seconds,
+        total_generations: state.generations + config.fit.generations,
+        phase: 1,
+    };
+    let halted = executor.run(&mut problem, &mut search, offsets, &mut |_, _| Ok(()));
+    if let Err(h) = halted {
+        return Err(halt_error(h, dir));
+    }
+    let n = shots.len();
+    state.failed_renders += problem.failed_renders();
+    state.shared = search.best().0.to_vec();
+    state.evaluations += search.evaluations() * n;
+    state.generations += search.generation();
+    state.shared_blocks += 1;
+    Ok(search.best().1 / 3.0)
+}
+
+/// A block that stopped without a result, as the error the user sees.
+fn halt_error(h: Halt, dir: Option<&RunDir>) -> Error {
+    let place = match dir {
+        Some(d) => format!(
+            "{} resumes the run from its last finished block (--resume)",
+            d.path().display()
+        ),
+        None => "nothing was saved".into(),
+    };
+    match h {
+        Halt::Error(e) => e,
+        Halt::Interrupted => Error::Run(format!("interrupted; {place}")),
+        Halt::AllFailed {
+            generation,
+            failures,
+        } => Error::Run(format!(
+            "every render of generation {generation} failed; {place}. First failure: {}",
+            failures.first().map(String::as_str).unwrap_or("?")
+        )),
+    }
+}

@@ -1,0 +1,154 @@
+//! What a set fit returns and writes: result.json (the shared parameters,
+//! the deviation over every photograph, and `shots` with each one's own
+//! parameters and deviation), fitted_scene.json (the shared model), one
+//! best image per photograph, and shots.json (the photographs with
+//! absolute paths, for `diagnose`).
+
+use super::state::SetState;
+use super::{problem::counted, varying, SetConfig};
+use crate::error::{Error, Result};
+use crate::fit::{render_seed, FitResult};
+use crate::metric::{deviation, Deviation};
+use crate::raster::Image;
+use crate::render::Renderer;
+use crate::rundir::{shot_best_name, RunDir, FITTED_SCENE, RESULT, SHOTS};
+use crate::scene::{ParamSpace, Scene};
+use crate::shots::{Shot, ShotsFile, FORMAT};
+use serde::{Deserialize, Serialize};
+
+/// One photograph's part of result.json.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct ShotResult {
+    pub name: String,
+    /// This photograph's own parameters.
+    pub params: serde_json::Map<String, serde_json::Value>,
+    pub deviation: Deviation,
+}
+
+/// One photograph's fit, in memory.
+#[derive(Clone, Debug)]
+pub struct ShotOutcome {
+    pub result: ShotResult,
+    /// The scene that draws it: shared and own values in place.
+    pub scene: Scene,
+    pub image: Image,
+}
+
+/// A set fit's outcome.
+#[derive(Clone, Debug)]
+pub struct SetOutcome {
+    /// `params` the shared parameters, `deviation` over every photograph,
+    /// `shots` each one's own.
+    pub result: FitResult,
+    /// The shared model (per-shot fields as the scene gives them).
+    pub scene: Scene,
+    pub shots: Vec<ShotOutcome>,
+}
+
+/// Renders every photograph at the final values, and writes the outputs.
+pub fn finish(
+    state: &SetState,
+    scene: &Scene,
+    shots: &[Shot],
+    renderer: &dyn Renderer,
+    config: &SetConfig,
+    space: &ParamSpace,
+    dir: Option<&RunDir>,
+) -> Result<SetOutcome> {
+    let shared = space.shared();
+    let scenes: Vec<Scene> = shots
+        .iter()
+        .enumerate()
+        .map(|(i, s)| state.shot_scene(i, s, &shared, &s.own_space(space)))
+        .collect();
+    let mut session = renderer.session(&scenes[0], &varying(space, shots), config.fit.jobs)?;
+    let images = session.render_batch(&scenes, render_seed(config.fit.de.seed, state.generations));
+    let mut outs = Vec::with_capacity(shots.len());
+    for ((shot, scene), img) in shots.iter().zip(scenes).zip(images) {
+        let image = img.map_err(|f| {
+            Error::Run(format!(
+                "{}: the final render of shot {} failed: {f}",
+                renderer.name(),
+                shot.name
+            ))
+        })?;
+        let t = &shot.target;
+        if image.dimensions() != t.image.dimensions() {
+            return Err(Error::Run(format!(
+                "{}: the final render of shot {} has the wrong size",
+                renderer.name(),
+                shot.name
+            )));
+        }
+        let own = shot.own_space(space);
+        outs.push(ShotOutcome {
+            result: ShotResult {
+                name: shot.name.clone(),
+                params: own.json_values(&scene),
+                deviation: deviation(&t.image, &image, t.mask.as_ref()),
+            },
+            scene,
+            image,
+        });
+    }
+    let parts: Vec<(Deviation, usize)> = outs
+        .iter()
+        .zip(shots)
+        .map(|(o, s)| (o.result.deviation, counted(&s.target)))
+        .collect();
+    let result = FitResult {
+        renderer: renderer.name(),
+        strategy: config.fit.de.strategy.to_string(),
+        seed: config.fit.de.seed,
+        params: shared.json_values(&outs[0].scene),
+        deviation: Deviation::pooled(&parts),
+        evaluations: state.evaluations,
+        generations: state.generations,
+        wall_seconds: state.seconds,
+        stop_reason: format!(
+            "{} blocks ({} shared)",
+            state.blocks_done.min(state.history.len()),
+            state.shared_blocks
+        ),
+        target: None,
+        failed_renders: state.failed_renders,
+        identifiability: None,
+        shots: Some(outs.iter().map(|o| o.result.clone()).collect()),
+    };
+    result.check_finite()?;
+    let outcome = SetOutcome {
+        result,
+        scene: shared.scene_at(scene, &state.shared),
+        shots: outs,
+    };
+    if let Some(d) = dir {
+        write(d, &outcome, shots)?;
+    }
+    Ok(outcome)
+}
+
+/// The set's files; result.json last, so that it means the rest is there.
+fn write(dir: &RunDir, outcome: &SetOutcome, shots: &[Shot]) -> Result<()> {
+    for o in &outcome.shots {
+        dir.write_image(&shot_best_name(&o.result.name), &o.image)?;
+    }
+    let file = ShotsFile {
+        format: FORMAT.into(),
+        shots: shots
+            .iter()
+            .map(|s| {
+                let mut e = s.entry.clone();
+                e.target = absolute(&e.target);
+                e.mask = e.mask.as_deref().map(absolute);
+                e
+            })
+            .collect(),
+    };
+    dir.write_json(SHOTS, &file)?;
+    dir.write_json(FITTED_SCENE, &outcome.scene)?;
+    dir.write_json(RESULT, &outcome.result)
+}
+
+fn absolute(p: &std::path::Path) -> std::path::PathBuf {
+    std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf())
+}
