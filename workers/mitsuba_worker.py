@@ -43,7 +43,10 @@ camera
   If up is parallel to the viewing direction, another up is chosen (world -z,
   or +x when looking along z) instead of failing.
   film: ``hdrfilm`` width x height from ``image``, pixel_format rgb, rfilter box.
-  sampler: ``independent``, sample_count = render.samples, seed = request seed.
+  sampler: ``multijitter`` (stratified: a narrow highlight within a pixel is
+  averaged like the built-in tracer's grid; the independent sampler put a
+  shininess-300 highlight 1.4 % off at 16 spp, this 0.3 %), sample_count =
+  render.samples, seed = request seed.
 integrator: hide_emitters = true (background black; area-light spheres are not
   seen by camera rays, though mirrors and glass show them).
   render.indirect true  -> ``path``, max_depth 9 (up to 8 bounces).
@@ -638,7 +641,7 @@ class MitsubaBackend:
         sensor = {
             "type": cam["type"],
             "to_world": T(cam["to_world"]),
-            "sampler": {"type": "independent", "sample_count": plan["spp"]},
+            "sampler": {"type": "multijitter", "sample_count": plan["spp"]},
             "film": {"type": "hdrfilm", "width": plan["width"], "height": plan["height"],
                      "pixel_format": "rgb", "rfilter": {"type": "box"}},
         }

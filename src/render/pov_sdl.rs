@@ -90,7 +90,7 @@ pub fn check(scene: &Scene) -> Result<(), String> {
     for l in &scene.lights {
         if l.kind == LightKind::Directional && l.radius > 0.0 {
             return Err(format!(
-                "lights.{}.radius: a directional light of angular size is not supported (POV-Ray's parallel lights are points at infinity); use phong",
+                "lights.{}.radius: a directional light of angular size is not supported (POV-Ray's parallel lights are points at infinity); use phong or blender",
                 l.name
             ));
         }
@@ -105,7 +105,7 @@ pub fn check(scene: &Scene) -> Result<(), String> {
         }
         if m.specular2.is_some_and(|k| k > 0.0) {
             return Err(format!(
-                "objects.{}.material.specular2: a second specular lobe is not supported by POV-Ray; use phong",
+                "objects.{}.material.specular2: a second specular lobe is not supported by POV-Ray; use phong, blender or mitsuba",
                 o.name
             ));
         }
