@@ -12,7 +12,7 @@ mod common;
 
 use common::*;
 use scenefit::raster::Image;
-use scenefit::render::{from_spec, Renderer};
+use scenefit::render::{from_spec, render_one, Renderer};
 use scenefit::scene::{parse, ParamSpace, Scene};
 
 /// Highlight pixels: the specular lobe changes them by more than this.
@@ -68,9 +68,18 @@ fn glossy(case: Case, specular: bool) -> Scene {
     parse(&v.to_string(), "glossy scene", &[]).expect("valid scene")
 }
 
-/// Renders every scene in one session of `spec`.
+/// Renders every scene with `spec`: the process-backed renderers in one
+/// session (one worker start), the built-in tracer one session per scene
+/// (a session caches what its base scene does not declare free, such as
+/// the shadows of its light).
 fn render_all(spec: &str, scenes: &[Scene]) -> Vec<Image> {
     let r: Box<dyn Renderer> = from_spec(spec).unwrap();
+    if spec == "phong" {
+        return scenes
+            .iter()
+            .map(|s| render_one(r.as_ref(), s, 0).expect("phong renders"))
+            .collect();
+    }
     let mut session = r
         .session(&scenes[0], &ParamSpace::default(), 1)
         .unwrap_or_else(|e| panic!("{spec}: {e}"));
