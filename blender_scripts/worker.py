@@ -42,11 +42,11 @@ Camera
 Lights (light objects are invisible to camera rays)
   point: POINT light at position, power P = 4*pi*I W (Cycles gives P/(4 pi)
     W/sr), colour = color, shadow_soft_size = radius (same total power).
-    falloff "none": light node tree Light Falloff(Strength 1).Constant ->
-    Emission strength, which cancels the 1/d^2 (E = I cos(theta), as if at
-    1 m).
-  directional: SUN with strength E (W/m^2), angle 0, colour = color, its
-    emission direction is -direction.
+    falloff_power p other than 2 (falloff "none" is p = 0): light node tree
+    Light Falloff(Strength 1).Linear (= the distance d) ^ (2 - p) ->
+    Emission strength, which turns Cycles' 1/d^2 into 1/d^p.
+  directional: SUN with strength E (W/m^2), angle 2*radius (its angular
+    diameter), colour = color, its emission direction is -direction.
 Ambient
   World: Background(color = ambient, strength 1) seen by every ray except
   camera rays (Light Path "Is Camera Ray" -> empty shader = black).  World
@@ -64,13 +64,19 @@ Shapes
   box: a shared flat-shaded unit cube [0,1]^3, location = min, scale = size.
   Cycles shades both sides of every face.
 Materials (per object, linked to the object's material slot)
-  specular = reflection = transmission = 0: Diffuse BSDF (Lambertian),
-    roughness 0, colour = diffuse*color.
-  otherwise: Principled BSDF (GGX), Base Color = diffuse*color, Metallic 0,
-    Specular = clamp(specular, 0, 1) (F0 = 0.08*Specular, so specular 0.5 <->
-    F0 0.04), Roughness = (2/(shininess+2))^(1/4), Transmission =
-    transmission, Transmission Roughness 0, IOR = ior; then Mix Shader
-    (fac = reflection) with a white Glossy BSDF (GGX, roughness 0 = mirror).
+  specular = specular2 = reflection = transmission = 0 ("lambertian"):
+    Diffuse BSDF (Lambertian), roughness 0, colour = diffuse*color.
+  transmission = 0 ("phong", the built-in tracer's material, see
+    Worker._phong_graph): Diffuse BSDF + two Glossy BSDFs (Ashikhmin-Shirley,
+    Roughness (2/(n+2))^(1/4), colour ks (n+8)/(n+1) H.V max(N.L, N.V)
+    F(H.V)/F0 computed per shading point for the first light, which makes
+    each the normalised Blinn-Phong lobe ks (n+8)/(8 pi) (N.H)^n F/F0) + a
+    sharp Glossy BSDF of colour `reflection`, added.
+  transmission > 0 ("principled", glass): Principled BSDF (GGX), Base Color
+    = diffuse*color, Metallic 0, Specular = clamp(specular, 0, 1), Roughness
+    = (2/(shininess+2))^(1/4), Transmission = transmission, Transmission
+    Roughness 0, IOR = ior; then Mix Shader (fac = reflection) with a white
+    Glossy BSDF (GGX, roughness 0 = mirror).
 Render
   Cycles, CPU, samples = render.samples, adaptive sampling off, denoising
   off, pixel filter BOX width 1, seed = request seed (not animated), clamping
@@ -80,8 +86,9 @@ Render
   exposure 1, dither 0, film not transparent.  Output PNG 8-bit RGB.
 Reuse
   The built scene is kept.  If a request's scene has the same structure
-  (camera type; lights by name, type and falloff kind; objects by name,
-  shape type and material kind lambertian/principled) as the previous one,
+  (camera type; lights by name, type and falloff kind inverse_square /
+  custom; objects by name, shape type and material kind lambertian / phong
+  / principled) as the previous one,
   only values are updated in place; otherwise every datablock the worker
   made is removed (bpy.data.*.remove) and the scene is rebuilt.  Cycles
   persistent data is on, so unchanged geometry (BVH) and shaders are kept

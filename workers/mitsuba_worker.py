@@ -65,7 +65,10 @@ lights (intensity I times color)
                    but does block other lights and indirect rays.
   directional    -> ``directional``, irradiance = E*color (W/m^2), travelling
                    along -direction (scene direction points towards the light).
-  falloff "none" -> error "falloff none unsupported" (Mitsuba has no such light).
+  falloff_power p other than 2 (falloff "none" is p = 0), radius 0
+                 -> ``scenefit_point`` (own emitter, register_plugins): intensity
+                   I*color falling off as 1/d^p. With radius > 0: error (the
+                   Rust side refuses it first).
 objects
   sphere  -> ``sphere`` (to_world = translate(center) * scale(radius)).
   plane   -> ``rectangle`` of half-size 1000 m around `point`, normal = `normal`
@@ -75,9 +78,15 @@ objects
   box     -> ``cube`` mesh whose vertices are set to center + half_size * unit cube.
 materials (d = diffuse, c = color, ks = specular, n = shininess, kr = reflection,
   kt = transmission)
-  ks = kr = kt = 0 -> ``twosided`` ``diffuse`` with reflectance d*c (Lambertian;
-                      not clamped to 1, negative values become 0).
-  otherwise        -> ``principled``: base_color d*c, metallic 0,
+  ks = ks2 = kr = kt = 0 -> ``twosided`` ``diffuse`` with reflectance d*c
+                      (Lambertian; not clamped to 1, negative values become 0).
+  kt = 0           -> ``twosided`` ``scenefit_phong`` (own BSDF, register_plugins):
+                      the built-in tracer's material, albedo d*c, lobes ks/n and
+                      ks2/n2 (specular2, shininess2), Schlick F0 = fresnel;
+                      kr > 0: ``blendbsdf`` (weight kr) with a white mirror, the
+                      scenefit_phong half scaled by 1/(1-kr) so that the mirror
+                      is added as in the built-in tracer.
+  kt > 0 (glass)   -> ``principled``: base_color d*c, metallic 0,
                       roughness (2/(n+2))^(1/4), specular level min(1, ks) (F0 = 0.08*ks, so
                       ks 0.5 <-> F0 0.04, as Blender); kt > 0: spec_trans = kt and eta = ior (Mitsuba then ignores
                       `specular`: F0 follows from ior).
@@ -86,8 +95,8 @@ materials (d = diffuse, c = color, ks = specular, n = shininess, kr = reflection
                       Without transmission the whole is wrapped in ``twosided``
                       (planes, quads and boxes shade on both sides); with transmission
                       it is not (a dielectric has two sides of its own).
-  Known differences from the Phong tracer: the principled diffuse lobe is Disney's
-  (brighter towards grazing angles), not Lambertian; the principled transmission
+  Known differences from the Phong tracer, for glass: the principled diffuse lobe
+  is Disney's (brighter towards grazing angles), not Lambertian; the principled transmission
   is tinted by base_color = d*c (diffuse 0 gives black glass, as in Blender's
   Principled BSDF); the lobes are mixed energy-conserving (blend), not added.
 Output: the film's linear RGB is converted with
@@ -478,7 +487,7 @@ def register_plugins(mi, dr):
 
         def sample(self, ctx, si, sample1, sample2, active=True):
             w = mi.warp.square_to_cosine_hemisphere(sample2)
-            bs = dr.zeros(mi.BSDFSample3f)
+            bs = mi.BSDFSample3f()
             bs.wo = mi.Vector3f(w.x, w.y, w.z * self._side(si))
             bs.pdf = mi.warp.square_to_cosine_hemisphere_pdf(w)
             bs.eta = 1.0
@@ -511,8 +520,10 @@ def register_plugins(mi, dr):
                 callback.put(k, getattr(self, k), mi.ParamFlags.NonDifferentiable)
 
         def sample_direction(self, it, sample, active=True):
-            ds = dr.zeros(mi.DirectionSample3f)
+            ds = mi.DirectionSample3f()
             ds.p = self.position
+            ds.n = mi.Normal3f(0.0)
+            ds.uv = mi.Point2f(0.0)
             ds.time = it.time
             ds.pdf = 1.0
             ds.delta = True
@@ -520,7 +531,8 @@ def register_plugins(mi, dr):
             dist = dr.norm(d)
             ds.d = d / dist
             ds.dist = dist
-            ds.emitter = mi.EmitterPtr(self)
+            # JIT variants hold emitter pointers in arrays, scalar ones the object
+            ds.emitter = mi.EmitterPtr(self) if hasattr(mi, "EmitterPtr") else self
             return ds, dr.select(active, self.intensity * dr.power(dist, -self.power), 0.0)
 
         def pdf_direction(self, it, ds, active=True):
@@ -541,8 +553,10 @@ def register_plugins(mi, dr):
             return ray, self.intensity * (4.0 * dr.pi)
 
         def sample_position(self, time, sample, active=True):
-            ps = dr.zeros(mi.PositionSample3f)
+            ps = mi.PositionSample3f()
             ps.p = self.position
+            ps.n = mi.Normal3f(0.0)
+            ps.uv = mi.Point2f(0.0)
             ps.time = time
             ps.pdf = 1.0
             ps.delta = True
