@@ -3,8 +3,8 @@
 //! 10-500, with and without `fresnel`, direct light only) every backend
 //! draws the built-in tracer's highlight within 3 % on the highlight's
 //! pixels and within 1 % over the image, and a scene as `scenefit diagnose`
-//! leaves it (with `falloff_power` and `specular2`) re-renders in Blender
-//! and Mitsuba within 1 % of the built-in tracer.
+//! leaves it (with `falloff_power` and `specular2`) re-renders in Blender,
+//! Mitsuba and POV-Ray within 1 % of the built-in tracer.
 //! Renderers run for real; a missing one skips its test unless CI=true.
 
 #[path = "backends_common/mod.rs"]
@@ -213,6 +213,14 @@ fn diagnosed_agrees(spec: &str) {
 fn blender_renders_a_diagnosed_scene() {
     if have("blender", "Blender") {
         diagnosed_agrees("blender");
+    }
+}
+
+/// POV-Ray draws the second lobe as a transparent texture layer.
+#[test]
+fn povray_renders_a_diagnosed_scene() {
+    if have("povray", "POV-Ray") {
+        diagnosed_agrees("povray");
     }
 }
 

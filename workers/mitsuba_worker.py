@@ -65,6 +65,8 @@ lights (intensity I times color)
                    but does block other lights and indirect rays.
   directional    -> ``directional``, irradiance = E*color (W/m^2), travelling
                    along -direction (scene direction points towards the light).
+                   radius r > 0: ``scenefit_sun`` (own emitter): each sample
+                   from normalize(direction + r * uniform disk point).
   falloff_power p other than 2 (falloff "none" is p = 0), radius 0
                  -> ``scenefit_point`` (own emitter, register_plugins): intensity
                    I*color falling off as 1/d^p. With radius > 0: error (the
@@ -367,8 +369,15 @@ def make_plan(scene):
             d = normalize(vec3(L.get("direction"), where + ".direction"), where + ".direction")
             travel = mul(d, -1.0)
             u, v = basis(travel)
-            lights.append({"name": name, "type": "directional", "irradiance": rgb,
-                           "to_world": columns_matrix(u, v, travel, (0.0, 0.0, 0.0))})
+            r = num(L.get("radius", 0.0), where + ".radius")
+            if r < 0.0:
+                raise SceneError("%s.radius: must be >= 0" % where)
+            if r > 0.0:
+                lights.append({"name": name, "type": "sun", "direction": d, "irradiance": rgb,
+                               "radius": r})
+            else:
+                lights.append({"name": name, "type": "directional", "irradiance": rgb,
+                               "to_world": columns_matrix(u, v, travel, (0.0, 0.0, 0.0))})
         else:
             raise SceneError("%s.type: unknown %r (point or directional)" % (where, ltype))
 
@@ -568,7 +577,77 @@ def register_plugins(mi, dr):
         def to_string(self):
             return "ScenefitPoint[]"
 
+    class ScenefitSun(mi.Emitter):
+        """A directional light of angular size: each sample comes from a
+        direction normalize(direction + radius * (disk point)), the disk
+        uniform, as the built-in tracer's soft shadows; irradiance E on a
+        surface facing it."""
+
+        def __init__(self, props):
+            mi.Emitter.__init__(self, props)
+            self.direction = mi.Vector3f(props["direction"]) if ("direction" in props) else mi.Vector3f(0, 1, 0)
+            self.irradiance = mi.Color3f(props["irradiance"]) if ("irradiance" in props) else mi.Color3f(1.0)
+            self.radius = mi.Float(prop(props, "radius", 0.0))
+            # each sample is one direction: a delta light for the integrators
+            self.m_flags = mi.EmitterFlags.DeltaDirection
+            self.parameters_changed([])
+
+        def parameters_changed(self, keys):
+            dr.make_opaque(self.direction, self.irradiance, self.radius)
+
+        def traverse(self, callback):
+            for k in ("direction", "irradiance", "radius"):
+                callback.put(k, getattr(self, k), mi.ParamFlags.NonDifferentiable)
+
+        def sample_direction(self, it, sample, active=True):
+            frame = mi.Frame3f(dr.normalize(self.direction))
+            disk = mi.warp.square_to_uniform_disk_concentric(sample)
+            d = dr.normalize(frame.n + self.radius * (frame.s * disk.x + frame.t * disk.y))
+            ds = mi.DirectionSample3f()
+            far = 1e7
+            ds.p = it.p + d * far
+            ds.n = -d
+            ds.uv = mi.Point2f(0.0)
+            ds.time = it.time
+            ds.pdf = 1.0
+            ds.delta = True
+            ds.d = d
+            ds.dist = far
+            ds.emitter = mi.EmitterPtr(self) if hasattr(mi, "EmitterPtr") else self
+            return ds, dr.select(active, self.irradiance, 0.0)
+
+        def pdf_direction(self, it, ds, active=True):
+            return mi.Float(0.0)
+
+        def eval_direction(self, it, ds, active=True):
+            return dr.select(active, self.irradiance, 0.0)
+
+        def eval(self, si, active=True):
+            return mi.Color3f(0.0)
+
+        def sample_ray(self, time, sample1, sample2, sample3, active=True):
+            # only light tracers call this: a ray from far along the axis
+            d = dr.normalize(self.direction)
+            return mi.Ray3f(d * 1e7, -d, time), self.irradiance
+
+        def sample_position(self, time, sample, active=True):
+            ps = mi.PositionSample3f()
+            ps.p = dr.normalize(self.direction) * 1e7
+            ps.n = -dr.normalize(self.direction)
+            ps.uv = mi.Point2f(0.0)
+            ps.time = time
+            ps.pdf = 1.0
+            ps.delta = True
+            return ps, mi.Color3f(1.0)
+
+        def bbox(self):
+            return mi.ScalarBoundingBox3f(mi.ScalarPoint3f(0.0))
+
+        def to_string(self):
+            return "ScenefitSun[]"
+
     mi.register_bsdf("scenefit_phong", lambda props: ScenefitPhong(props))
+    mi.register_emitter("scenefit_sun", lambda props: ScenefitSun(props))
     mi.register_emitter("scenefit_point", lambda props: ScenefitPoint(props))
 
 
@@ -677,6 +756,9 @@ class MitsubaBackend:
             key = "L%d" % i
             if L["type"] == "point":
                 d[key] = {"type": "point", "position": list(L["position"]), "intensity": self.rgb(L["intensity"])}
+            elif L["type"] == "sun":
+                d[key] = {"type": "scenefit_sun", "direction": list(L["direction"]),
+                          "irradiance": self.rgb(L["irradiance"]), "radius": L["radius"]}
             elif L["type"] == "falloff_point":
                 d[key] = {"type": "scenefit_point", "position": list(L["position"]),
                           "intensity": self.rgb(L["intensity"]), "power": L["power"]}
@@ -712,6 +794,10 @@ class MitsubaBackend:
             if L["type"] == "point":
                 v[key + ".position"] = ("point", L["position"])
                 v[key + ".intensity.value"] = ("color", L["intensity"])
+            elif L["type"] == "sun":
+                v[key + ".direction"] = ("vector", L["direction"])
+                v[key + ".irradiance"] = ("color", L["irradiance"])
+                v[key + ".radius"] = ("float", L["radius"])
             elif L["type"] == "falloff_point":
                 v[key + ".position"] = ("point", L["position"])
                 v[key + ".intensity"] = ("color", L["intensity"])
@@ -741,6 +827,8 @@ class MitsubaBackend:
             return mi.Color3f(*value)
         if kind == "point":
             return mi.Point3f(*value)
+        if kind == "vector":
+            return mi.Vector3f(*value)
         if kind == "transform":
             return type(self.params[key])(mi.ScalarTransform4f([list(r) for r in value]))
         if kind == "box":
@@ -794,7 +882,7 @@ class MitsubaBackend:
         if self.mi.variant().startswith("scalar"):
             # scalar variants hold the own plug-ins' values as plain floats,
             # which mi.traverse cannot write: a new value is a new scene
-            signature = (signature, repr([L for L in plan["lights"] if L["type"] == "falloff_point"]),
+            signature = (signature, repr([L for L in plan["lights"] if L["type"] in ("falloff_point", "sun")]),
                          repr([o["material"] for o in plan["objects"] if o["material"]["kind"][0] == "phong"]))
         if signature != self.signature or self.scene is None:
             self.build(plan, signature)

@@ -5,9 +5,8 @@
 //! Blinn-Phong lobes, `fresnel`, `specular2`) and any `falloff_power`
 //! (docs/renderers.md, "One material convention").
 //!
-//! Refused: a directional light's `radius` in Mitsuba (its directional
-//! light is a point at infinity), a Mitsuba area light (`radius` > 0) with
-//! a falloff other than 1/d^2, and `fresnel` or `specular2` on a
+//! Refused: a Mitsuba area light (`radius` > 0: a shape with an area
+//! emitter) with a falloff other than 1/d^2, and `fresnel` or `specular2` on a
 //! transmitting material (glass is drawn by the principled BSDF, with its
 //! own Fresnel term and one lobe). `indirect_light` is the built-in
 //! tracer's stand-in for what `render.indirect` traces: not refused.
@@ -21,14 +20,8 @@ pub fn check(scene: &Scene, backend: &str) -> Result<()> {
     let refuse = |field: String, why: &str| Err(Error::Usage(format!("{backend}: {field}: {why}")));
     let mitsuba = backend == "mitsuba";
     for l in &scene.lights {
-        if !mitsuba || l.radius <= 0.0 {
+        if !mitsuba || l.radius <= 0.0 || l.kind != LightKind::Point {
             continue;
-        }
-        if l.kind == LightKind::Directional {
-            return refuse(
-                format!("lights.{}.radius", l.name),
-                "a directional light of angular size is not supported; use phong or blender",
-            );
         }
         let power = l.falloff_power.unwrap_or(match l.falloff {
             Falloff::InverseSquare => 2.0,
