@@ -42,11 +42,11 @@ Camera
 Lights (light objects are invisible to camera rays)
   point: POINT light at position, power P = 4*pi*I W (Cycles gives P/(4 pi)
     W/sr), colour = color, shadow_soft_size = radius (same total power).
-    falloff "none": light node tree Light Falloff(Strength 1).Constant ->
-    Emission strength, which cancels the 1/d^2 (E = I cos(theta), as if at
-    1 m).
-  directional: SUN with strength E (W/m^2), angle 0, colour = color, its
-    emission direction is -direction.
+    falloff_power p other than 2 (falloff "none" is p = 0): light node tree
+    Light Falloff(Strength 1).Linear (= the distance d) ^ (2 - p) ->
+    Emission strength, which turns Cycles' 1/d^2 into 1/d^p.
+  directional: SUN with strength E (W/m^2), angle 2*radius (its angular
+    diameter), colour = color, its emission direction is -direction.
 Ambient
   World: Background(color = ambient, strength 1) seen by every ray except
   camera rays (Light Path "Is Camera Ray" -> empty shader = black).  World
@@ -64,13 +64,19 @@ Shapes
   box: a shared flat-shaded unit cube [0,1]^3, location = min, scale = size.
   Cycles shades both sides of every face.
 Materials (per object, linked to the object's material slot)
-  specular = reflection = transmission = 0: Diffuse BSDF (Lambertian),
-    roughness 0, colour = diffuse*color.
-  otherwise: Principled BSDF (GGX), Base Color = diffuse*color, Metallic 0,
-    Specular = clamp(specular, 0, 1) (F0 = 0.08*Specular, so specular 0.5 <->
-    F0 0.04), Roughness = (2/(shininess+2))^(1/4), Transmission =
-    transmission, Transmission Roughness 0, IOR = ior; then Mix Shader
-    (fac = reflection) with a white Glossy BSDF (GGX, roughness 0 = mirror).
+  specular = specular2 = reflection = transmission = 0 ("lambertian"):
+    Diffuse BSDF (Lambertian), roughness 0, colour = diffuse*color.
+  transmission = 0 ("phong", the built-in tracer's material, see
+    Worker._phong_graph): Diffuse BSDF + two Glossy BSDFs (Ashikhmin-Shirley,
+    Roughness (2/(n+2))^(1/4), colour ks (n+8)/(n+1) H.V max(N.L, N.V)
+    F(H.V)/F0 computed per shading point for the first light, which makes
+    each the normalised Blinn-Phong lobe ks (n+8)/(8 pi) (N.H)^n F/F0) + a
+    sharp Glossy BSDF of colour `reflection`, added.
+  transmission > 0 ("principled", glass): Principled BSDF (GGX), Base Color
+    = diffuse*color, Metallic 0, Specular = clamp(specular, 0, 1), Roughness
+    = (2/(shininess+2))^(1/4), Transmission = transmission, Transmission
+    Roughness 0, IOR = ior; then Mix Shader (fac = reflection) with a white
+    Glossy BSDF (GGX, roughness 0 = mirror).
 Render
   Cycles, CPU, samples = render.samples, adaptive sampling off, denoising
   off, pixel filter BOX width 1, seed = request seed (not animated), clamping
@@ -80,8 +86,9 @@ Render
   exposure 1, dither 0, film not transparent.  Output PNG 8-bit RGB.
 Reuse
   The built scene is kept.  If a request's scene has the same structure
-  (camera type; lights by name, type and falloff kind; objects by name,
-  shape type and material kind lambertian/principled) as the previous one,
+  (camera type; lights by name, type and falloff kind inverse_square /
+  custom; objects by name, shape type and material kind lambertian / phong
+  / principled) as the previous one,
   only values are updated in place; otherwise every datablock the worker
   made is removed (bpy.data.*.remove) and the scene is rebuilt.  Cycles
   persistent data is on, so unchanged geometry (BVH) and shaders are kept
@@ -246,10 +253,33 @@ def fresh_nodes(owner, output_type):
 
 
 def material_kind(m, where="material"):
+    """lambertian (diffuse only), phong (the built-in tracer's lobes, own
+    node graph) or principled (transmission: glass)."""
     spec = _num(m, "specular", where, 0.0)
+    spec2 = _num(m, "specular2", where, 0.0)
     refl = _num(m, "reflection", where, 0.0)
     trans = _num(m, "transmission", where, 0.0)
-    return "lambertian" if spec == 0.0 and refl == 0.0 and trans == 0.0 else "principled"
+    if trans != 0.0:
+        return "principled"
+    if spec == 0.0 and spec2 == 0.0 and refl == 0.0:
+        return "lambertian"
+    return "phong"
+
+
+def falloff_kind(light):
+    """inverse_square (Cycles' own), or custom: 1/d^p through a node tree."""
+    if light.get("type") != "point":
+        return "inverse_square"
+    p = light.get("falloff_power")
+    if p is None:
+        p = 0.0 if light.get("falloff", "inverse_square") == "none" else 2.0
+    return "inverse_square" if p == 2.0 else "custom"
+
+
+def falloff_power(light, where):
+    if "falloff_power" in light:
+        return _num(light, "falloff_power", where)
+    return 0.0 if light.get("falloff", "inverse_square") == "none" else 2.0
 
 
 def structure_of(scene):
@@ -268,8 +298,10 @@ def structure_of(scene):
         where = "lights[%d]" % i
         if not isinstance(l, dict):
             raise SceneError("%s must be an object" % where)
-        ls.append((str(l.get("name", "light%d" % i)), l.get("type"),
-                   l.get("falloff", "inverse_square")))
+        falloff = l.get("falloff", "inverse_square")
+        if falloff not in ("inverse_square", "none"):
+            raise SceneError("%s: falloff must be 'inverse_square' or 'none', got %r" % (where, falloff))
+        ls.append((str(l.get("name", "light%d" % i)), l.get("type"), falloff_kind(l)))
     os_ = []
     for i, o in enumerate(objects):
         where = "objects[%d]" % i
@@ -479,17 +511,20 @@ class Worker:
                 ld = bpy.data.lights.new(PREFIX + "light_" + name, "SUN")
             else:
                 raise SceneError("%s: type must be 'point' or 'directional', got %r" % (where, ltype))
-            if falloff not in ("inverse_square", "none"):
-                raise SceneError("%s: falloff must be 'inverse_square' or 'none', got %r" % (where, falloff))
             fnode = None
-            if falloff == "none" and ltype == "point":
+            if falloff == "custom":
+                # Cycles' light falls off as 1/d^2; Light Falloff's Linear
+                # output is d, so strength d^(2-p) makes it 1/d^p.
                 nt, out = fresh_nodes(ld, "ShaderNodeOutputLight")
                 em = nt.nodes.new("ShaderNodeEmission")
-                fnode = nt.nodes.new("ShaderNodeLightFalloff")
-                fnode.inputs["Strength"].default_value = 1.0
-                fnode.inputs["Smooth"].default_value = 0.0
+                lf = nt.nodes.new("ShaderNodeLightFalloff")
+                lf.inputs["Strength"].default_value = 1.0
+                lf.inputs["Smooth"].default_value = 0.0
+                fnode = nt.nodes.new("ShaderNodeMath")
+                fnode.operation = "POWER"
                 em.inputs["Color"].default_value = (1, 1, 1, 1)
-                nt.links.new(fnode.outputs["Constant"], em.inputs["Strength"])
+                nt.links.new(lf.outputs["Linear"], fnode.inputs[0])
+                nt.links.new(fnode.outputs["Value"], em.inputs["Strength"])
                 nt.links.new(em.outputs["Emission"], out.inputs["Surface"])
             ld.cycles.cast_shadow = True
             ld.cycles.use_multiple_importance_sampling = True
@@ -533,6 +568,8 @@ class Worker:
             d.inputs["Roughness"].default_value = 0.0
             nt.links.new(d.outputs["BSDF"], out.inputs["Surface"])
             nodes["diffuse"] = d
+        elif kind == "phong":
+            self._phong_graph(nt, out, nodes)
         else:
             p = nt.nodes.new("ShaderNodeBsdfPrincipled")
             p.distribution = "GGX"
@@ -556,6 +593,75 @@ class Worker:
             nodes["principled"] = p
             nodes["mix"] = mix
         return mat, nodes
+
+    def _phong_graph(self, nt, out, nodes):
+        """The built-in tracer's material: Diffuse (Lambertian) + two
+        Ashikhmin-Shirley glossy lobes + a mirror, added.  Cycles' isotropic
+        Ashikhmin-Shirley lobe with roughness r = (2/(n+2))^(1/4) is
+        (n+1)/(8 pi) (N.H)^n / (H.V max(N.L, N.V)); its colour is set per
+        shading point to  ks (n+8)/(n+1) H.V max(N.L, N.V) F(H.V)/F0  for L
+        the direction to the scene's first light, which turns it into
+        ks (n+8)/(8 pi) (N.H)^n F/F0 exactly for that light."""
+        N = nt.nodes
+        L = nt.links
+
+        def vmath(op, a, b=None):
+            v = N.new("ShaderNodeVectorMath")
+            v.operation = op
+            L.new(a, v.inputs[0])
+            if b is not None:
+                L.new(b, v.inputs[1])
+            return v
+
+        def math(op, a=None, b=None):
+            m = N.new("ShaderNodeMath")
+            m.operation = op
+            for i, x in enumerate((a, b)):
+                if x is not None:
+                    L.new(x, m.inputs[i])
+            return m
+
+        geo = N.new("ShaderNodeNewGeometry")
+        at = N.new("ShaderNodeCombineXYZ")  # light position, or its direction
+        # point light: L = at - P; directional: L = at (weight 0 on P)
+        wp = vmath("SCALE", geo.outputs["Position"])
+        d = vmath("SUBTRACT", at.outputs["Vector"], wp.outputs["Vector"])
+        lv = vmath("NORMALIZE", d.outputs["Vector"])
+        h = vmath("NORMALIZE", vmath("ADD", lv.outputs["Vector"], geo.outputs["Incoming"]).outputs["Vector"])
+        hv = vmath("DOT_PRODUCT", h.outputs["Vector"], geo.outputs["Incoming"])
+        nl = vmath("DOT_PRODUCT", geo.outputs["Normal"], lv.outputs["Vector"])
+        nv = vmath("DOT_PRODUCT", geo.outputs["Normal"], geo.outputs["Incoming"])
+        mx = math("MAXIMUM", nl.outputs["Value"], nv.outputs["Value"])
+        one_minus = math("SUBTRACT", None, hv.outputs["Value"])
+        one_minus.inputs[0].default_value = 1.0
+        p5 = math("POWER", one_minus.outputs["Value"])
+        p5.inputs[1].default_value = 5.0
+        fr = math("MULTIPLY_ADD", p5.outputs["Value"])  # 1 + (1-F0)/F0 (1-H.V)^5
+        fr.inputs[2].default_value = 1.0
+        base = math("MULTIPLY", hv.outputs["Value"], mx.outputs["Value"])
+        base = math("MULTIPLY", base.outputs["Value"], fr.outputs["Value"])
+        diffuse = N.new("ShaderNodeBsdfDiffuse")
+        diffuse.inputs["Roughness"].default_value = 0.0
+        shader = diffuse.outputs["BSDF"]
+        lobes = []
+        for _ in range(2):
+            k = math("MULTIPLY", base.outputs["Value"])
+            g = N.new("ShaderNodeBsdfGlossy")
+            g.distribution = "ASHIKHMIN_SHIRLEY"
+            L.new(k.outputs["Value"], g.inputs["Color"])
+            add = N.new("ShaderNodeAddShader")
+            L.new(shader, add.inputs[0])
+            L.new(g.outputs["BSDF"], add.inputs[1])
+            shader = add.outputs["Shader"]
+            lobes.append((k, g))
+        mirror = N.new("ShaderNodeBsdfGlossy")
+        mirror.distribution = "SHARP"
+        add = N.new("ShaderNodeAddShader")
+        L.new(shader, add.inputs[0])
+        L.new(mirror.outputs["BSDF"], add.inputs[1])
+        L.new(add.outputs["Shader"], out.inputs["Surface"])
+        nodes.update({"diffuse": diffuse, "at": at, "weight": wp, "fresnel": fr,
+                      "lobes": lobes, "mirror": mirror})
 
     # -- values -------------------------------------------------------------
     def apply(self, scene):
@@ -642,11 +748,17 @@ class Worker:
                 if rad < 0:
                     raise SceneError("%s: radius must be >= 0" % where)
                 _set(ld, "shadow_soft_size", rad)
+                if fnode is not None:
+                    _set(fnode.inputs[1], "default_value", 2.0 - falloff_power(l, where))
             else:
                 d = B(_vec3(l, "direction", where))
                 _set(lo, "rotation_quaternion", _rot_z_to(d, where))
                 _set(ld, "energy", inten)
-                ld.angle = 0.0
+                rad = _num(l, "radius", where, 0.0)
+                if not 0.0 <= rad < math.pi / 2:
+                    raise SceneError("%s: radius must be in [0, pi/2)" % where)
+                # the sun's angle is its angular diameter
+                _set(ld, "angle", 2.0 * rad)
 
         # objects
         for ent, o in zip(self.objects, scene.get("objects", [])):
@@ -688,9 +800,9 @@ class Worker:
                 if any(abs(a - b) > 0 for a, b in zip(old, co)):
                     me.vertices.foreach_set("co", co)
                     me.update()
-            self._apply_material(ent, o.get("material", {}), where)
+            self._apply_material(ent, o.get("material", {}), where, scene.get("lights", []))
 
-    def _apply_material(self, ent, m, where):
+    def _apply_material(self, ent, m, where, lights):
         where = where + " material"
         color = _vec3(m, "color", where)
         kd = _num(m, "diffuse", where, 1.0)
@@ -698,6 +810,9 @@ class Worker:
         nodes = ent["nodes"]
         if ent["kind"] == "lambertian":
             _set(nodes["diffuse"].inputs["Color"], "default_value", base)
+            return
+        if ent["kind"] == "phong":
+            self._apply_phong(nodes, m, where, base, lights)
             return
         ks = _num(m, "specular", where, 0.0)
         n = _num(m, "shininess", where, 10.0)
@@ -713,6 +828,36 @@ class Worker:
         _set(p.inputs["Transmission"], "default_value", min(1.0, max(0.0, kt)))
         _set(p.inputs["IOR"], "default_value", ior)
         _set(nodes["mix"].inputs[0], "default_value", min(1.0, max(0.0, kr)))
+
+    def _apply_phong(self, nodes, m, where, base, lights):
+        ks = _num(m, "specular", where, 0.0)
+        n = _num(m, "shininess", where, 10.0)
+        ks2 = _num(m, "specular2", where, 0.0)
+        n2 = _num(m, "shininess2", where, n)
+        kr = _num(m, "reflection", where, 0.0)
+        f0 = _num(m, "fresnel", where, 1.0)
+        if n < 0 or n2 < 0:
+            raise SceneError("%s: shininess must be >= 0" % where)
+        if not 0.0 < f0 <= 1.0:
+            raise SceneError("%s: fresnel must be in (0, 1]" % where)
+        _set(nodes["diffuse"].inputs["Color"], "default_value", base)
+        _set(nodes["fresnel"].inputs[1], "default_value", (1.0 - f0) / f0)
+        for (k, g), (ks_, n_) in zip(nodes["lobes"], ((ks, n), (ks2, n2))):
+            _set(k.inputs[1], "default_value", max(ks_, 0.0) * (n_ + 8.0) / (n_ + 1.0))
+            _set(g.inputs["Roughness"], "default_value", (2.0 / (n_ + 2.0)) ** 0.25)
+        kr = min(max(kr, 0.0), 1.0)
+        _set(nodes["mirror"].inputs["Color"], "default_value", (kr, kr, kr, 1.0))
+        # the lobe is exact for the first light (the usual single key light)
+        at, w = (0.0, 1.0, 0.0), 0.0
+        if lights:
+            l0 = lights[0]
+            if l0.get("type") == "point":
+                at, w = B(_vec3(l0, "position", "light")), 1.0
+            else:
+                at = B(_vec3(l0, "direction", "light"))
+        for i, c in enumerate(at):
+            _set(nodes["at"].inputs[i], "default_value", c)
+        _set(nodes["weight"].inputs["Scale"], "default_value", w)
 
     # -- one request ------------------------------------------------------
     def render(self, scene, output, seed):

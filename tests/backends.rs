@@ -176,12 +176,15 @@ fn missing_renderer_says_how_to_install_it() {
     assert!(String::from_utf8_lossy(&o.stderr).contains("SCENEFIT_PYTHON"));
 }
 
+/// What Mitsuba truly cannot draw (an area light falling off other than
+/// 1/d^2) is a user's error naming the field, before any worker starts.
 #[test]
-fn mitsuba_refuses_falloff_none() {
+fn mitsuba_refuses_an_area_light_without_inverse_square() {
     let dir = tempdir();
     let d = dir.path();
     let mut s = diffuse_scene(16, 1);
     s["lights"][0]["falloff"] = "none".into();
+    s["lights"][0]["radius"] = 0.2.into();
     write_json(d, "scene.json", &s);
     let o = run(
         d,
@@ -196,7 +199,9 @@ fn mitsuba_refuses_falloff_none() {
         &[],
     );
     expect_code(&o, 2);
-    assert!(String::from_utf8_lossy(&o.stderr).contains("falloff \"none\" is not supported"));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("lights.key.radius"), "{err}");
+    assert_eq!(err.trim().lines().count(), 1, "{err}");
 }
 
 #[test]

@@ -8,9 +8,11 @@
 //! Scene fields: all but what `pbr_fields.rs` refuses, mapped by the worker (its module docstring;
 //! docs/renderers.md, "Blender"): camera, `image`, `ambient`, `render.samples`
 //! and `render.indirect`, point (power 4 pi I W) and directional lights,
-//! `falloff`, `radius`, spheres, planes, quads, boxes, materials (Lambertian
-//! Diffuse BSDF or Principled BSDF with a mirror mix). `render.antialias` and
-//! `render.max_depth` are the built-in tracer's and unused here.
+//! `falloff`, `falloff_power`, `radius`, spheres, planes, quads, boxes,
+//! materials (Lambertian Diffuse BSDF; the built-in tracer's lobes, with
+//! `fresnel` and `specular2`, through a node graph of the worker's own;
+//! Principled BSDF for glass). `render.antialias` and `render.max_depth`
+//! are the built-in tracer's and unused here.
 
 use super::external::{python_worker_dir, ExternalSession};
 use super::{RenderSession, Renderer};

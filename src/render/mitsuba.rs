@@ -5,20 +5,21 @@
 //! line's `--python`), else `SCENEFIT_PYTHON`, names another Python.
 //! The worker keeps the loaded scene and only updates changed values.
 //!
-//! Scene fields: all of them but `falloff: "none"` (refused: Mitsuba has no
-//! such light) and what `pbr_fields.rs` refuses, mapped by the worker (its module docstring;
-//! docs/renderers.md, "Mitsuba"): camera, `image`, `ambient`,
-//! `render.samples` and `render.indirect`, point lights (W/sr), spheres as
-//! area lights for `radius` > 0, directional lights, spheres, planes,
-//! quads, boxes, materials (twosided diffuse or principled with a mirror
-//! blend). `render.antialias` and `render.max_depth` are unused here.
+//! Scene fields: all but what `pbr_fields.rs` refuses, mapped by the worker
+//! (its module docstring; docs/renderers.md, "Mitsuba"): camera, `image`,
+//! `ambient`, `render.samples` and `render.indirect`, point lights (W/sr;
+//! any falloff through the worker's own `scenefit_point` emitter), spheres
+//! as area lights for `radius` > 0, directional lights, spheres, planes,
+//! quads, boxes, materials (the built-in tracer's lobes through the
+//! worker's own `scenefit_phong` BSDF; principled for glass).
+//! `render.antialias` and `render.max_depth` are unused here.
 
 use super::external::{python_worker_dir, ExternalSession};
 use super::{RenderSession, Renderer};
 use crate::error::{Error, Result};
 use crate::exec::discover;
 use crate::exec::process::CommandSpec;
-use crate::scene::{Falloff, LightKind, ParamSpace, Scene};
+use crate::scene::{ParamSpace, Scene};
 use std::time::Duration;
 
 /// The worker script, as shipped in workers/.
@@ -50,7 +51,6 @@ impl Renderer for Mitsuba {
         jobs: usize,
     ) -> Result<Box<dyn RenderSession>> {
         super::pbr_fields::check(base, "mitsuba")?;
-        check(base)?;
         let python = match &self.0.python {
             Some(p) => p.to_string_lossy().into_owned(),
             None => std::env::var(ENV_PYTHON)
@@ -88,17 +88,4 @@ impl Renderer for Mitsuba {
             Err((e, _)) => Err(e),
         }
     }
-}
-
-/// What the Mitsuba worker cannot render.
-fn check(scene: &Scene) -> Result<()> {
-    for l in &scene.lights {
-        if l.kind == LightKind::Point && l.falloff == Falloff::None {
-            return Err(Error::Usage(format!(
-                "mitsuba: lights.{}: falloff \"none\" is not supported (Mitsuba's lights fall off with distance); use inverse_square or another renderer",
-                l.name
-            )));
-        }
-    }
-    Ok(())
 }

@@ -1,40 +1,54 @@
-//! The scene fields the Blender and Mitsuba workers cannot map, refused
-//! with a clear error before any worker starts (a worker would silently
-//! ignore them and render another scene than the user's).
+//! The scene fields the Blender and Mitsuba workers cannot draw, refused
+//! with a clear error before any worker starts (a worker would otherwise
+//! render another scene than the user's). Everything else is drawn: both
+//! workers draw the built-in tracer's material (Lambertian plus normalised
+//! Blinn-Phong lobes, `fresnel`, `specular2`) and any `falloff_power`
+//! (docs/renderers.md, "One material convention").
 //!
-//! Refused: a point light's `falloff_power` other than 2 (their lights fall
-//! off as 1/d^2), a directional light's `radius` (their suns and
-//! directional lights are points at infinity here), a material's
-//! `specular2` (one lobe). Not refused, documented in docs/renderers.md:
-//! `fresnel` (the principled BSDF has its own Fresnel term) and
-//! `indirect_light` (the built-in tracer's stand-in for what
-//! `render.indirect` traces).
+//! Refused: a Mitsuba area light (`radius` > 0: a shape with an area
+//! emitter) with a falloff other than 1/d^2, and `fresnel` or `specular2` on a
+//! transmitting material (glass is drawn by the principled BSDF, with its
+//! own Fresnel term and one lobe). `indirect_light` is the built-in
+//! tracer's stand-in for what `render.indirect` traces: not refused.
 
 use crate::error::{Error, Result};
-use crate::scene::{LightKind, Scene};
+use crate::scene::{Falloff, LightKind, Scene};
 
-/// Err naming the first field `backend` cannot render.
+/// Err naming the first field `backend` ("blender" or "mitsuba") cannot
+/// render.
 pub fn check(scene: &Scene, backend: &str) -> Result<()> {
     let refuse = |field: String, why: &str| Err(Error::Usage(format!("{backend}: {field}: {why}")));
+    let mitsuba = backend == "mitsuba";
     for l in &scene.lights {
-        if let Some(p) = l.falloff_power.filter(|p| *p != 2.0) {
-            return refuse(
-                format!("lights.{}.falloff_power {p}", l.name),
-                "not supported (its lights fall off as 1/d^2); use phong or povray",
-            );
+        if !mitsuba || l.radius <= 0.0 || l.kind != LightKind::Point {
+            continue;
         }
-        if l.kind == LightKind::Directional && l.radius > 0.0 {
+        let power = l.falloff_power.unwrap_or(match l.falloff {
+            Falloff::InverseSquare => 2.0,
+            Falloff::None => 0.0,
+        });
+        if power != 2.0 {
             return refuse(
                 format!("lights.{}.radius", l.name),
-                "a directional light of angular size is not supported; use phong",
+                "an area light falls off as 1/d^2 here; with falloff_power or falloff \"none\" use radius 0, or phong or blender",
             );
         }
     }
     for o in &scene.objects {
-        if o.material.specular2.is_some_and(|k| k > 0.0) {
+        let m = &o.material;
+        if m.transmission <= 0.0 {
+            continue;
+        }
+        if m.specular2.is_some_and(|k| k > 0.0) {
             return refuse(
                 format!("objects.{}.material.specular2", o.name),
-                "a second specular lobe is not supported; use phong",
+                "a second lobe on a transmitting material is not supported; use phong",
+            );
+        }
+        if m.fresnel.is_some_and(|f| f != 1.0) {
+            return refuse(
+                format!("objects.{}.material.fresnel", o.name),
+                "a transmitting material takes its Fresnel term from `ior`; remove `fresnel` or use phong",
             );
         }
     }

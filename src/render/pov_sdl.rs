@@ -25,13 +25,18 @@
 //! - names: never written (comments say `lights[i]`, `objects[i]`): the
 //!   SDL holds only numbers and fixed keywords, whatever a scene contains.
 //! - refused (a clear error): a directional light's `radius`, a material's
-//!   `fresnel` (other than 1) and `specular2`. `indirect_light` (the
+//!   `fresnel` (other than 1), `specular2` on glass. `indirect_light` (the
 //!   built-in tracer's estimate) is not used: `render.indirect` is POV-Ray's.
 //! - material (kd, ks, n, kr, kt, ior; T = min(kt, MAX_TRANSMIT)):
 //!   pigment `rgbt <color, T>`; finish `ambient kd/(1-T)`,
 //!   `diffuse kd/(pi (1-T))` (POV-Ray's diffuse has no 1/pi and is scaled by
 //!   1-T), `specular ks (n+8)/(8 pi)`, `roughness 1/n` (Blinn's N.H^n),
-//!   `reflection kr`; `interior { ior }` when kt > 0.
+//!   `reflection kr`; `interior { ior }` when kt > 0. `specular2` ks2,
+//!   `shininess2` n2: a second texture layered on top, fully transparent
+//!   (`rgbt <1,1,1,1>`, no ambient, no diffuse) with `specular
+//!   ks2 (n2+8)/(8 pi)`, `roughness 1/n2`: POV-Ray adds a layer's highlight
+//!   whatever its transparency (measured: the same image as the lobe in the
+//!   bottom finish).
 
 use crate::scene::{CameraKind, Falloff, LightKind, Material, Scene, ShapeKind, Vec3};
 use std::f64::consts::PI;
@@ -90,7 +95,7 @@ pub fn check(scene: &Scene) -> Result<(), String> {
     for l in &scene.lights {
         if l.kind == LightKind::Directional && l.radius > 0.0 {
             return Err(format!(
-                "lights.{}.radius: a directional light of angular size is not supported (POV-Ray's parallel lights are points at infinity); use phong",
+                "lights.{}.radius: a directional light of angular size is not supported (POV-Ray's parallel lights are points at infinity); use phong or blender",
                 l.name
             ));
         }
@@ -103,9 +108,9 @@ pub fn check(scene: &Scene) -> Result<(), String> {
                 o.name
             ));
         }
-        if m.specular2.is_some_and(|k| k > 0.0) {
+        if m.specular2.is_some_and(|k| k > 0.0) && m.transmission > 0.0 {
             return Err(format!(
-                "objects.{}.material.specular2: a second specular lobe is not supported by POV-Ray; use phong",
+                "objects.{}.material.specular2: a second specular lobe on a transmitting material is not supported by POV-Ray; use phong",
                 o.name
             ));
         }
@@ -327,7 +332,17 @@ fn material(m: &Material) -> String {
     } else {
         String::new()
     };
-    format!("texture {{ pigment {{ {pigment} }} finish {{ {finish} }} }}{interior}")
+    let mut layer = String::new();
+    if let Some(ks2) = m.specular2.filter(|&k| k > 0.0 && t == 0.0) {
+        let n2 = m.shininess2.unwrap_or(m.shininess);
+        let _ = write!(
+            layer,
+            " texture {{ pigment {{ rgbt <1, 1, 1, 1> }} finish {{ ambient 0 diffuse 0 specular {} roughness {} }} }}",
+            num(ks2 * (n2 + 8.0) / (8.0 * PI)),
+            num(1.0 / n2.max(1e-9))
+        );
+    }
+    format!("texture {{ pigment {{ {pigment} }} finish {{ {finish} }} }}{layer}{interior}")
 }
 
 fn dot(a: Vec3, b: Vec3) -> f64 {
