@@ -4,8 +4,7 @@ use super::progress::Progress;
 use super::search::{self, Search};
 use crate::error::Result;
 use crate::fit::{self, FitTarget};
-use crate::metric::Mask;
-use crate::raster::io as image_io;
+use crate::raster::Encoding;
 use crate::render::from_spec_with;
 use crate::rundir::Mode;
 use crate::scene::{load_with, Override, Scene};
@@ -25,23 +24,25 @@ pub struct FitInputs {
     /// Pixels that count: white in an image of the same size.
     #[arg(long)]
     pub mask: Option<PathBuf>,
+    /// How the target's values encode light: srgb or linear (default:
+    /// linear for OpenEXR, srgb for the rest).
+    #[arg(long, value_name = "srgb|linear")]
+    pub encoding: Option<Encoding>,
 }
 
 impl FitInputs {
-    /// The photograph and mask, checked against the scene's image size.
-    pub fn target(&self, scene: &Scene) -> Result<FitTarget> {
-        let (w, h) = (scene.image.width, scene.image.height);
-        let image = image_io::read_target(&self.target, w, h)?;
-        let mask = self
-            .mask
-            .as_ref()
-            .map(|m| Mask::load(m, w, h))
-            .transpose()?;
-        Ok(FitTarget {
-            image,
-            mask,
-            path: Some(self.target.clone()),
-        })
+    /// The photograph and mask, checked against the scene's image size;
+    /// the photograph's saturated pixels are left out of the mask (said on
+    /// stderr unless `quiet`).
+    pub fn target(&self, scene: &Scene, quiet: bool) -> Result<FitTarget> {
+        let size = (scene.image.width, scene.image.height);
+        let mask = self.mask.as_deref().map(|m| (m, "--mask"));
+        let (target, note) =
+            FitTarget::from_photo(&self.target, "--target", mask, self.encoding, size)?;
+        if let (Some(n), false) = (note, quiet) {
+            eprintln!("{n}");
+        }
+        Ok(target)
     }
 }
 
@@ -81,7 +82,7 @@ pub struct FitArgs {
 pub fn run(a: FitArgs) -> Result<()> {
     let mut scene = load_with(&a.inputs.scene, &a.set)?;
     crate::scene::nuisance::add(&mut scene, &a.nuisance);
-    let target = a.inputs.target(&scene)?;
+    let target = a.inputs.target(&scene, a.quiet)?;
     let renderer = from_spec_with(&a.renderer, &a.render_options.options())?;
     let mut config = a.search.config(renderer.default_jobs())?;
     let file = a.inputs.scene.display().to_string();

@@ -14,6 +14,7 @@ mod identity;
 mod observers;
 mod output;
 mod problem;
+mod target;
 mod uncertainty;
 
 pub use checkpoint::Checkpoint;
@@ -88,6 +89,9 @@ impl Default for FitConfig {
 #[derive(Clone, Debug)]
 pub struct FitTarget {
     pub image: Image,
+    /// The photograph's unrounded 8-bit sRGB levels (3 per pixel) when it
+    /// is finer than 8-bit sRGB (16-bit, float, linear); None otherwise.
+    pub levels: Option<Vec<f32>>,
     pub mask: Option<Mask>,
     /// For result.json.
     pub path: Option<PathBuf>,
@@ -342,6 +346,10 @@ fn finish(
         seed: config.de.seed,
         params: space.json_values(&scene),
         deviation: deviation(&target.image, &image, target.mask.as_ref()),
+        deviation_precise: target
+            .levels
+            .as_ref()
+            .map(|l| crate::metric::deviation_levels(l, &image, target.mask.as_ref())),
         evaluations: state.evaluations_before + search.evaluations(),
         generations: state.generation_offset + search.generation(),
         wall_seconds: state.elapsed_before,
