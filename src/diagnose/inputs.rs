@@ -23,9 +23,9 @@ impl Inputs {
     /// when present.
     pub fn from_fit_dir(dir: &Path, target: Option<&Path>, mask: Option<&Path>) -> Result<Inputs> {
         let scene = crate::scene::load(&dir.join(FITTED_SCENE))?;
-        let target_path = match target {
-            Some(t) => t.to_path_buf(),
-            None => fit_target(dir)?,
+        let (target_path, what) = match target {
+            Some(t) => (t.to_path_buf(), "--target"),
+            None => (fit_target(dir)?, "the fit's target"),
         };
         let size = (scene.image.width, scene.image.height);
         let default_mask = dir.join(MASK);
@@ -33,7 +33,7 @@ impl Inputs {
             .map(Path::to_path_buf)
             .or_else(|| default_mask.exists().then_some(default_mask));
         let mask = mask_path.as_deref().map(|m| (m, "--mask"));
-        let (target, note) = FitTarget::from_photo(&target_path, "--target", mask, None, size)?;
+        let (target, note) = FitTarget::from_photo(&target_path, what, mask, None, size)?;
         if let Some(n) = note {
             // Diagnose has no --quiet and prints its own summary: said once.
             eprintln!("{n}");
