@@ -65,6 +65,7 @@ fn main() {
         &scene,
         &FitTarget {
             image: target,
+            levels: None,
             mask: None,
             path: None,
         },

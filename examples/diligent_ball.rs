@@ -80,6 +80,7 @@ fn main() {
         let t = std::time::Instant::now();
         let fit_target = FitTarget {
             image: target.clone(),
+            levels: None,
             mask: Some(mask.clone()),
             path: Some(dir.join("target.png")),
         };

@@ -75,6 +75,7 @@ fn diagnosis_of_a_photograph_brings_the_light_closer() {
     };
     let t = FitTarget {
         image: target.clone(),
+        levels: None,
         mask: Some(mask.clone()),
         path: None,
     };
@@ -145,6 +146,7 @@ fn light_direction_of_a_photograph_within_four_degrees() {
     };
     let t = FitTarget {
         image: target,
+        levels: None,
         mask: Some(mask),
         path: None,
     };

@@ -69,6 +69,7 @@ fn recovers_hidden_truth_for_the_papers_six_colours() {
         };
         let target = FitTarget {
             image,
+            levels: None,
             mask: None,
             path: None,
         };

@@ -99,6 +99,7 @@ pub fn run(a: DemoArgs) -> Result<()> {
         }
         let target = FitTarget {
             image,
+            levels: None,
             mask: None,
             path: Some(run_dir.file(TARGET)),
         };

@@ -4,6 +4,7 @@ use super::progress::Progress;
 use super::search::{self, Search};
 use crate::error::{Error, Result};
 use crate::fit::{self, FitTarget};
+use crate::raster::Encoding;
 use crate::render::from_spec_with;
 use crate::rundir::Mode;
 use crate::scene::{load_with, Override, Scene};
@@ -29,17 +30,27 @@ pub struct FitInputs {
     /// "per_shot" get one value per photograph.
     #[arg(long, conflicts_with = "target", value_name = "SHOTS.json")]
     pub shots: Option<PathBuf>,
+    /// How the photograph encodes light: srgb (default; linear for
+    /// OpenEXR) or linear.
+    #[arg(long, value_name = "srgb|linear", conflicts_with = "shots")]
+    pub encoding: Option<Encoding>,
 }
 
 impl FitInputs {
     /// The photograph and mask, checked against the scene's image size.
-    pub fn target(&self, scene: &Scene) -> Result<FitTarget> {
+    pub fn target(&self, scene: &Scene, quiet: bool) -> Result<FitTarget> {
         let Some(target) = &self.target else {
             return Err(Error::Usage(
                 "--shots: this command fits one photograph; give --target".into(),
             ));
         };
-        FitTarget::read(target, self.mask.as_deref(), None, scene)
+        let size = (scene.image.width, scene.image.height);
+        let mask = self.mask.as_deref().map(|m| (m, "--mask"));
+        let (target, note) = FitTarget::from_photo(target, "--target", mask, self.encoding, size)?;
+        if let (Some(n), false) = (note, quiet) {
+            eprintln!("{n}");
+        }
+        Ok(target)
     }
 }
 
@@ -84,10 +95,17 @@ pub fn run(a: FitArgs) -> Result<()> {
     let mut scene = load_with(&a.inputs.scene, &a.set)?;
     crate::scene::nuisance::add(&mut scene, &a.nuisance);
     if let Some(shots) = &a.inputs.shots {
-        let shots = crate::shots::load(shots, &scene)?;
+        let (shots, notes) = crate::shots::load(shots, &scene)?;
+        if let (Some(first), false) = (notes.first(), a.quiet) {
+            eprintln!(
+                "--shots: saturated pixels left out of the fit in {} of {} photographs (first: {first})",
+                notes.len(),
+                shots.len()
+            );
+        }
         return run_set(&a, &scene, &shots);
     }
-    let target = a.inputs.target(&scene)?;
+    let target = a.inputs.target(&scene, a.quiet)?;
     let renderer = from_spec_with(&a.renderer, &a.render_options.options())?;
     let mut config = a.search.config(renderer.default_jobs())?;
     let file = a.inputs.scene.display().to_string();

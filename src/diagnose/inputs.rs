@@ -1,10 +1,11 @@
 //! What a diagnosis starts from: the fitted scene of a fit directory, its
-//! target, and the mask.
+//! target, and the mask (without the target's saturated pixels, as in the
+//! fit).
 
 use crate::error::Result;
-use crate::fit::FitResult;
+use crate::fit::{FitResult, FitTarget};
 use crate::metric::Mask;
-use crate::raster::{io as image_io, Image};
+use crate::raster::Image;
 use crate::rundir::{RunDir, FITTED_SCENE, MASK};
 use crate::scene::Scene;
 use std::path::{Path, PathBuf};
@@ -22,21 +23,25 @@ impl Inputs {
     /// when present.
     pub fn from_fit_dir(dir: &Path, target: Option<&Path>, mask: Option<&Path>) -> Result<Inputs> {
         let scene = crate::scene::load(&dir.join(FITTED_SCENE))?;
-        let target_path = match target {
-            Some(t) => t.to_path_buf(),
-            None => fit_target(dir)?,
+        let (target_path, what) = match target {
+            Some(t) => (t.to_path_buf(), "--target"),
+            None => (fit_target(dir)?, "the fit's target"),
         };
-        let (w, h) = (scene.image.width, scene.image.height);
-        let target = image_io::read_target(&target_path, w, h)?;
+        let size = (scene.image.width, scene.image.height);
         let default_mask = dir.join(MASK);
         let mask_path = mask
             .map(Path::to_path_buf)
             .or_else(|| default_mask.exists().then_some(default_mask));
-        let mask = mask_path.map(|m| Mask::load(&m, w, h)).transpose()?;
+        let mask = mask_path.as_deref().map(|m| (m, "--mask"));
+        let (target, note) = FitTarget::from_photo(&target_path, what, mask, None, size)?;
+        if let Some(n) = note {
+            // Diagnose has no --quiet and prints its own summary: said once.
+            eprintln!("{n}");
+        }
         Ok(Inputs {
             scene,
-            target,
-            mask,
+            target: target.image,
+            mask: target.mask,
         })
     }
 }

@@ -102,6 +102,7 @@ impl<'a> Refits<'a> {
     ) -> Refits<'a> {
         let target = FitTarget {
             image: inputs.target.clone(),
+            levels: None,
             mask: inputs.mask.clone(),
             path: None,
         };

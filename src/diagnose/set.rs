@@ -52,7 +52,7 @@ impl SetInputs {
             return Ok(None);
         };
         let scene = crate::scene::load(&dir.join(FITTED_SCENE))?;
-        let shots = crate::shots::load(&dir.join(SHOTS), &scene)?;
+        let (shots, _) = crate::shots::load(&dir.join(SHOTS), &scene)?;
         let own = shots
             .iter()
             .map(|s| {

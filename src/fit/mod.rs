@@ -336,6 +336,10 @@ fn finish(
         seed: config.de.seed,
         params: space.json_values(&scene),
         deviation: deviation(&target.image, &image, target.mask.as_ref()),
+        deviation_precise: target
+            .levels
+            .as_ref()
+            .map(|l| crate::metric::deviation_levels(l, &image, target.mask.as_ref())),
         evaluations: state.evaluations_before + search.evaluations(),
         generations: state.generation_offset + search.generation(),
         wall_seconds: state.elapsed_before,

@@ -17,6 +17,11 @@ pub struct FitResult {
     pub seed: u64,
     pub params: serde_json::Map<String, serde_json::Value>,
     pub deviation: Deviation,
+    /// The deviation from the photograph's unrounded levels, when it is
+    /// finer than 8-bit sRGB (16-bit, float, linear); `deviation` is on
+    /// the photograph rounded to 8-bit sRGB.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub deviation_precise: Option<Deviation>,
     pub evaluations: usize,
     pub generations: usize,
     pub wall_seconds: f64,
@@ -56,9 +61,14 @@ impl FitResult {
                 bad = Some(k.clone());
             }
         }
-        let d = &self.deviation;
-        if bad.is_none() && ![d.r, d.g, d.b, d.average].iter().all(|x| x.is_finite()) {
-            bad = Some("deviation".into());
+        for (name, d) in [
+            ("deviation", Some(&self.deviation)),
+            ("deviation_precise", self.deviation_precise.as_ref()),
+        ] {
+            let Some(d) = d else { continue };
+            if bad.is_none() && ![d.r, d.g, d.b, d.average].iter().all(|x| x.is_finite()) {
+                bad = Some(name.into());
+            }
         }
         match bad {
             None => Ok(()),

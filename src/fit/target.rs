@@ -1,43 +1,65 @@
-//! What a fit compares against: a photograph, the pixels that count, and
-//! where it came from; read from files the same way for one photograph
-//! (`--target`) and for each photograph of a set (`--shots`).
+//! A photograph and its optional mask as a fit's target: what every
+//! command that fits a photograph (one, or each of a set) reads through.
 
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::metric::Mask;
 use crate::raster::{io as image_io, Encoding, Image};
-use crate::scene::Scene;
 use std::path::{Path, PathBuf};
 
 /// What the fit compares against.
 #[derive(Clone, Debug)]
 pub struct FitTarget {
     pub image: Image,
+    /// The photograph's unrounded 8-bit sRGB levels (3 per pixel) when it
+    /// is finer than 8-bit sRGB (16-bit, float, linear); None otherwise.
+    pub levels: Option<Vec<f32>>,
     pub mask: Option<Mask>,
     /// For result.json.
     pub path: Option<PathBuf>,
 }
 
 impl FitTarget {
-    /// Reads the photograph at `path` (and its mask), checked against the
-    /// scene's image size; linear values are sRGB-encoded as renders are.
-    pub fn read(
-        path: &Path,
-        mask: Option<&Path>,
+    /// Reads the photograph `photo` (`what` names it in errors, e.g.
+    /// `--target`) in `encoding` (None: by its format) and the mask
+    /// `mask` (its path and name), both the scene's `size`. The pixels
+    /// that count are the mask's (every pixel without one) minus the
+    /// photograph's saturated ones, whose true value the camera lost.
+    /// Returns the target and, when saturated pixels were dropped, one
+    /// line saying so for the user.
+    pub fn from_photo(
+        photo: &Path,
+        what: &str,
+        mask: Option<(&Path, &str)>,
         encoding: Option<Encoding>,
-        scene: &Scene,
-    ) -> Result<FitTarget> {
-        let (w, h) = (scene.image.width, scene.image.height);
-        let mut image = image_io::read_target(path, w, h)?;
-        if encoding == Some(Encoding::Linear) {
-            for v in image.iter_mut() {
-                *v = crate::render::srgb::encode(*v as f64 / 255.0);
-            }
+        size: (u32, u32),
+    ) -> Result<(FitTarget, Option<String>)> {
+        let p = image_io::read_photo(photo, what, size, encoding)?;
+        let mask = mask
+            .map(|(m, name)| Mask::read(m, name, size.0, size.1))
+            .transpose()?;
+        let (mask, dropped) = Mask::without(mask, size.0, size.1, &p.saturated);
+        let maximum = if p.bits == 16 { "65535" } else { "255" };
+        if mask.as_ref().is_some_and(|m| m.pixels().is_empty()) {
+            return Err(Error::Image {
+                path: photo.to_path_buf(),
+                message: format!(
+                    "{what}: every pixel that counts is saturated (a channel at {maximum}); expected some unclipped pixels to fit"
+                ),
+            });
         }
-        let mask = mask.map(|m| Mask::load(m, w, h)).transpose()?;
-        Ok(FitTarget {
-            image,
+        let note = (dropped > 0).then(|| {
+            format!(
+                "{what} {}: {dropped} saturated pixel{} (a channel at {maximum}) left out of the fit",
+                photo.display(),
+                if dropped == 1 { "" } else { "s" }
+            )
+        });
+        let target = FitTarget {
+            levels: (!p.is_plain()).then_some(p.levels),
+            image: p.image,
             mask,
-            path: Some(path.to_path_buf()),
-        })
+            path: Some(photo.to_path_buf()),
+        };
+        Ok((target, note))
     }
 }

@@ -4,7 +4,9 @@
 //!
 //! Deviation, per channel: `100 * mean_i |T_i - R_i| / 255` over the mask's
 //! pixels (all pixels when there is none), on 8-bit sRGB values; `average`
-//! is the mean of r, g and b.
+//! is the mean of r, g and b. A photograph finer than 8-bit sRGB (16-bit,
+//! float, linear) also has a precise deviation, [`deviation_levels`]: the
+//! same formula on its unrounded levels.
 
 pub mod mask;
 
@@ -24,12 +26,12 @@ pub struct Deviation {
 
 impl Deviation {
     fn from_sums(sums: [u64; 3], count: u64) -> Deviation {
+        Deviation::from_level_sums(sums.map(|s| s as f64), count)
+    }
+
+    fn from_level_sums(sums: [f64; 3], count: u64) -> Deviation {
         let scale = 100.0 / (255.0 * count.max(1) as f64);
-        let (r, g, b) = (
-            sums[0] as f64 * scale,
-            sums[1] as f64 * scale,
-            sums[2] as f64 * scale,
-        );
+        let (r, g, b) = (sums[0] * scale, sums[1] * scale, sums[2] * scale);
         Deviation {
             r,
             g,
@@ -86,6 +88,30 @@ pub fn deviation(target: &Image, render: &Image, mask: Option<&Mask>) -> Deviati
     }
 }
 
+/// The deviation of `render` from a photograph's unrounded 8-bit sRGB
+/// `levels` (3 per pixel, `render`'s size) over `mask`: [`deviation`]
+/// without the target's rounding to whole levels.
+pub fn deviation_levels(levels: &[f32], render: &Image, mask: Option<&Mask>) -> Deviation {
+    let r = render.as_raw();
+    debug_assert_eq!(levels.len(), r.len());
+    let mut sums = [0f64; 3];
+    let mut add = |i: usize| {
+        for c in 0..3 {
+            sums[c] += (levels[i + c] - r[i + c] as f32).abs() as f64;
+        }
+    };
+    match mask {
+        None => {
+            (0..r.len()).step_by(3).for_each(&mut add);
+            Deviation::from_level_sums(sums, (r.len() / 3) as u64)
+        }
+        Some(m) => {
+            m.pixels().iter().for_each(|&px| add(px as usize * 3));
+            Deviation::from_level_sums(sums, m.pixels().len() as u64)
+        }
+    }
+}
+
 /// Render − target per channel value over `mask` (all pixels when none), in
 /// 8-bit levels: what a local search fits in least squares. Their absolute
 /// sum, scaled, is [`Deviation::fitness`].
@@ -122,5 +148,26 @@ mod tests {
         let m = Mask::from_pixels(4, 2, vec![0, 1]);
         let dm = deviation(&t, &r, Some(&m));
         assert!((dm.r - 10.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn level_deviation_matches_on_whole_levels_and_sees_fractions() {
+        let t = Image::from_pixel(4, 2, image::Rgb([100, 100, 200]));
+        let mut r = t.clone();
+        r.put_pixel(0, 0, image::Rgb([100 + 51, 100, 200 - 102]));
+        let whole: Vec<f32> = t.as_raw().iter().map(|&v| v as f32).collect();
+        let m = Mask::from_pixels(4, 2, vec![0, 1]);
+        for mask in [None, Some(&m)] {
+            let (a, b) = (deviation(&t, &r, mask), deviation_levels(&whole, &r, mask));
+            assert!((a.average - b.average).abs() < 1e-9 && (a.b - b.b).abs() < 1e-9);
+        }
+        // Half a level off everywhere in red: 0.5 / 255 = 0.196 %.
+        let half: Vec<f32> = whole
+            .iter()
+            .enumerate()
+            .map(|(i, &v)| v + if i % 3 == 0 { 0.5 } else { 0.0 })
+            .collect();
+        let d = deviation_levels(&half, &t, None);
+        assert!((d.r - 50.0 / 255.0).abs() < 1e-9 && d.g == 0.0, "{d:?}");
     }
 }

@@ -1,7 +1,7 @@
 //! Reading and writing images with errors that name the file and what was
 //! expected.
 
-use super::Image;
+use super::{Encoding, Image, Photo};
 use crate::error::{Error, Result};
 use crate::fsio::{self, CappedRead};
 use std::path::Path;
@@ -11,15 +11,23 @@ pub const MAX_IMAGE_FILE_BYTES: u64 = 1 << 30;
 /// The largest width or height decoded, pixels (the scene's own limit).
 const MAX_SIDE: u32 = crate::scene::limits::MAX_IMAGE_SIDE;
 
-/// Reads an image file as 8-bit RGB; `what` names it in errors (`--target`).
+/// Reads an image file of any size as 8-bit sRGB RGB, in its format's
+/// default encoding (an OpenEXR is converted from linear); `what` names it
+/// in errors (`--target`).
 pub fn read_image(path: &Path, what: &str) -> Result<Image> {
-    read_checked(path, what, None)
+    let (img, format) = read_decoded(path, what, None)?;
+    Ok(Photo::from_decoded(img, Encoding::default_for(format)).image)
 }
 
-/// Reads at most `MAX_IMAGE_FILE_BYTES` of `path` and decodes it, after
-/// checking the dimensions the header declares (at most `MAX_SIDE`, and
-/// `expect` when given) so that nothing large is allocated for a bad file.
-fn read_checked(path: &Path, what: &str, expect: Option<(u32, u32)>) -> Result<Image> {
+/// Reads at most `MAX_IMAGE_FILE_BYTES` of `path` and decodes it (PNG, BMP,
+/// TIFF or OpenEXR, at any depth), after checking the dimensions the header
+/// declares (at most `MAX_SIDE`, and `expect` when given) so that nothing
+/// large is allocated for a bad file. Returns the image and its format.
+pub fn read_decoded(
+    path: &Path,
+    what: &str,
+    expect: Option<(u32, u32)>,
+) -> Result<(image::DynamicImage, image::ImageFormat)> {
     let bad = |message: String| Error::Image {
         path: path.to_path_buf(),
         message: format!("{what}: {message}"),
@@ -34,7 +42,7 @@ fn read_checked(path: &Path, what: &str, expect: Option<(u32, u32)>) -> Result<I
     })?;
     let undecodable = |e: image::ImageError| {
         bad(format!(
-            "expected a PNG, BMP or other image file, could not decode it ({e})"
+            "expected a PNG, BMP, TIFF or OpenEXR image, could not decode it ({e})"
         ))
     };
     let reader = || {
@@ -42,6 +50,9 @@ fn read_checked(path: &Path, what: &str, expect: Option<(u32, u32)>) -> Result<I
             .with_guessed_format()
             .map_err(|e| Error::io(path, e))
     };
+    let format = reader()?.format().ok_or_else(|| {
+        bad("expected a PNG, BMP, TIFF or OpenEXR image, could not decode it (none of these formats)".into())
+    })?;
     let (w, h) = reader()?.into_dimensions().map_err(undecodable)?;
     if w == 0 || h == 0 || w > MAX_SIDE || h > MAX_SIDE {
         return Err(bad(format!(
@@ -56,12 +67,26 @@ fn read_checked(path: &Path, what: &str, expect: Option<(u32, u32)>) -> Result<I
         }
     }
     let img = reader()?.decode().map_err(undecodable)?;
-    Ok(img.to_rgb8())
+    Ok((img, format))
 }
 
 /// Reads the target photograph and checks its size against the scene's.
 pub fn read_target(path: &Path, width: u32, height: u32) -> Result<Image> {
-    read_checked(path, "--target", Some((width, height)))
+    Ok(read_photo(path, "--target", (width, height), None)?.image)
+}
+
+/// Reads a photograph of the scene's `size` (`what` names it in errors):
+/// 8- or 16-bit PNG or TIFF, float TIFF or OpenEXR, in `encoding` (when
+/// none is given: linear for OpenEXR, sRGB for the rest).
+pub fn read_photo(
+    path: &Path,
+    what: &str,
+    size: (u32, u32),
+    encoding: Option<Encoding>,
+) -> Result<Photo> {
+    let (img, format) = read_decoded(path, what, Some(size))?;
+    let encoding = encoding.unwrap_or(Encoding::default_for(format));
+    Ok(Photo::from_decoded(img, encoding))
 }
 
 /// The format a file name asks for: PNG or BMP by the extension. Checked

@@ -176,6 +176,7 @@ mod tests {
             seed: 1,
             params: Default::default(),
             deviation: Deviation::default(),
+            deviation_precise: None,
             evaluations: 220,
             generations: 10,
             wall_seconds: 1.1,

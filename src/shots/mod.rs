@@ -69,14 +69,16 @@ impl Shot {
     }
 }
 
-/// Reads the shots file at `path` for `scene`.
-pub fn load(path: &Path, scene: &Scene) -> Result<Vec<Shot>> {
+/// Reads the shots file at `path` for `scene`: the shots, and a line for
+/// each photograph whose saturated pixels were left out.
+pub fn load(path: &Path, scene: &Scene) -> Result<(Vec<Shot>, Vec<String>)> {
     let file = path.display().to_string();
     let file_data = read(path, &file)?;
     let dir = path.parent().unwrap_or(Path::new("."));
     let space = ParamSpace::from_scene(scene);
     let mut names = BTreeSet::new();
     let mut shots = Vec::with_capacity(file_data.shots.len());
+    let mut notes = Vec::new();
     for (i, e) in file_data.shots.into_iter().enumerate() {
         let at = format!("shots[{i}]");
         if !valid_name(&e.name) {
@@ -96,9 +98,11 @@ pub fn load(path: &Path, scene: &Scene) -> Result<Vec<Shot>> {
                 ),
             ));
         }
-        shots.push(shot(e, dir, scene, &space, &file, &at)?);
+        let (s, note) = shot(e, dir, scene, &space, &file, &at)?;
+        shots.push(s);
+        notes.extend(note);
     }
-    Ok(shots)
+    Ok((shots, notes))
 }
 
 /// The file's typed contents, with its format and size checked.
@@ -166,7 +170,7 @@ fn shot(
     space: &ParamSpace,
     file: &str,
     at: &str,
-) -> Result<Shot> {
+) -> Result<(Shot, Option<String>)> {
     let mut overrides = Vec::with_capacity(e.set.len());
     for (param, value) in &e.set {
         let key = format!("{at}.set.{param}");
@@ -192,11 +196,18 @@ fn shot(
         .map(|s| s.parse())
         .transpose()
         .map_err(|m: String| Error::invalid(file, format!("{at}.encoding"), m))?;
-    let target = FitTarget::read(&e.target, e.mask.as_deref(), encoding, &shot_scene)?;
-    Ok(Shot {
-        name: e.name.clone(),
-        scene: shot_scene,
-        target,
-        entry: e,
-    })
+    let size = (shot_scene.image.width, shot_scene.image.height);
+    let what = format!("{at}.target");
+    let mask_what = format!("{at}.mask");
+    let mask = e.mask.as_deref().map(|m| (m, mask_what.as_str()));
+    let (target, note) = FitTarget::from_photo(&e.target, &what, mask, encoding, size)?;
+    Ok((
+        Shot {
+            name: e.name.clone(),
+            scene: shot_scene,
+            target,
+            entry: e,
+        },
+        note,
+    ))
 }

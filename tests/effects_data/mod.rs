@@ -137,6 +137,7 @@ pub fn case(effect: &str, variant: u32, strength: f64, seed: u64, noise: f64) ->
 pub fn fit_case(c: &Case, dir: &Path, seed: u64) -> fit::FitResult {
     let target = FitTarget {
         image: c.target.clone(),
+        levels: None,
         mask: None,
         path: Some(dir.join("target.png")),
     };

@@ -8,7 +8,7 @@ use super::state::SetState;
 use super::{problem::counted, varying, SetConfig};
 use crate::error::{Error, Result};
 use crate::fit::{render_seed, FitResult};
-use crate::metric::{deviation, Deviation};
+use crate::metric::{deviation, deviation_levels, Deviation};
 use crate::raster::Image;
 use crate::render::Renderer;
 use crate::rundir::{shot_best_name, RunDir, FITTED_SCENE, RESULT, SHOTS};
@@ -102,6 +102,7 @@ pub fn finish(
         seed: config.fit.de.seed,
         params: shared.json_values(&outs[0].scene),
         deviation: Deviation::pooled(&parts),
+        deviation_precise: precise(&outs, shots),
         evaluations: state.evaluations,
         generations: state.generations,
         wall_seconds: state.seconds,
@@ -125,6 +126,27 @@ pub fn finish(
         write(d, &outcome, shots)?;
     }
     Ok(outcome)
+}
+
+/// The deviation from the photographs' unrounded levels, over the set,
+/// when any photograph is finer than 8-bit sRGB.
+fn precise(outs: &[ShotOutcome], shots: &[Shot]) -> Option<Deviation> {
+    if shots.iter().all(|s| s.target.levels.is_none()) {
+        return None;
+    }
+    let parts: Vec<(Deviation, usize)> = outs
+        .iter()
+        .zip(shots)
+        .map(|(o, s)| {
+            let t = &s.target;
+            let d = match &t.levels {
+                Some(l) => deviation_levels(l, &o.image, t.mask.as_ref()),
+                None => o.result.deviation,
+            };
+            (d, counted(t))
+        })
+        .collect();
+    Some(Deviation::pooled(&parts))
 }
 
 /// The set's files; result.json last, so that it means the rest is there.
