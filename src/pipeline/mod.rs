@@ -8,18 +8,24 @@
 //! Writes into DIR:
 //! - `stage1/`: a fit (as `scenefit fit`) with the stage-1 renderer;
 //! - `stage2/input_scene.json`: the handover (see `handover.rs`);
-//! - `stage2/`: a fit with the stage-2 renderer, seeded around the stage-1
-//!   values (`start_radius`), and `handover.png`: the stage-1 values as the
-//!   stage-2 renderer draws them;
+//! - `stage2/`: stage 2 and `handover.png` (the stage-1 values as the
+//!   stage-2 renderer draws them). Stage 2 runs by one of two methods:
+//!   `mapped` (the default, `spacemap.rs`): output space mapping, the
+//!   stage-1 renderer as a corrected surrogate of the stage-2 one, a few
+//!   dozen stage-2 renders; `de`: a DE fit with the stage-2 renderer,
+//!   seeded around the stage-1 values (`start_radius`) in narrowed bounds;
 //! - `stageN/trace.tsv` (see `trace.rs`);
 //! - `target.png` (and `mask.png`): what both stages were compared with;
 //! - `comparison.json` (see `comparison.rs`).
 
 pub mod comparison;
 pub mod handover;
+pub mod moves;
+pub mod spacemap;
 pub mod trace;
 
 pub use comparison::{Comparison, Handover, StageSummary};
+pub use spacemap::Iteration;
 
 use crate::error::{Error, Result};
 use crate::fit::{self, FitConfig, FitOutcome, FitResult, FitTarget, Observer};
@@ -30,6 +36,7 @@ use crate::rundir::{
     Kind, Mode, RunDir, CHECKPOINT, COMPARISON, HANDOVER, INPUT_SCENE, MASK, STAGE1, STAGE2, TARGET,
 };
 use crate::scene::Scene;
+use serde::{Deserialize, Serialize};
 use std::path::Path;
 use std::time::Instant;
 
@@ -51,6 +58,50 @@ pub struct PipelineConfig {
     pub keep_bounds: Vec<String>,
     /// What to do with what is already in the pipeline's directory.
     pub mode: Mode,
+    /// How stage 2 searches.
+    pub method: Stage2Method,
+    /// The mapped method's budgets.
+    pub mapped: MappedBudget,
+}
+
+/// How stage 2 searches: by space mapping (a few stage-2 renders, the
+/// stage-1 renderer as the corrected surrogate) or by DE with the stage-2
+/// renderer alone.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum Stage2Method {
+    #[default]
+    Mapped,
+    De,
+}
+
+impl std::fmt::Display for Stage2Method {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Stage2Method::Mapped => "mapped",
+            Stage2Method::De => "de",
+        })
+    }
+}
+
+/// The mapped stage 2's budgets.
+#[derive(Clone, Debug)]
+pub struct MappedBudget {
+    /// Stage-2 renders at most (the handover render not counted).
+    pub fine_renders: usize,
+    /// Each iteration's surrogate fit with the stage-1 renderer.
+    pub surrogate_population: usize,
+    pub surrogate_generations: usize,
+}
+
+impl Default for MappedBudget {
+    fn default() -> Self {
+        MappedBudget {
+            fine_renders: 30,
+            surrogate_population: 16,
+            surrogate_generations: 20,
+        }
+    }
 }
 
 impl Default for PipelineConfig {
@@ -71,6 +122,8 @@ impl Default for PipelineConfig {
             from_scratch: false,
             keep_bounds: Vec::new(),
             mode: Mode::Fresh,
+            method: Stage2Method::default(),
+            mapped: MappedBudget::default(),
         }
     }
 }
@@ -78,6 +131,8 @@ impl Default for PipelineConfig {
 /// Progress of a pipeline: each stage's start, then its generations.
 pub trait StageObserver: Observer {
     fn stage(&mut self, _stage: u32, _renderer: &str, _dir: &Path) {}
+    /// An iteration of the mapped stage 2.
+    fn iteration(&mut self, _iteration: &Iteration) {}
 }
 
 impl StageObserver for () {}
@@ -117,31 +172,76 @@ pub fn run(
 
     // Stage 2: the local refinement with the physically based renderer.
     observer.stage(2, &stage2_renderer.name(), stage2_dir.path());
-    let (r2, wall2) = run_stage(
-        &input,
-        target,
-        stage2_renderer,
-        &stage2_config,
-        &stage2_dir,
-        observer,
-    )?;
-    let (r1, r2) = (r1.result, r2.result);
+    let start = if config.from_scratch { scene } else { fitted };
+    let (r2, scene2, wall2) = match config.method {
+        Stage2Method::De => {
+            let (r2, wall2) = run_stage(
+                &input,
+                target,
+                stage2_renderer,
+                &stage2_config,
+                &stage2_dir,
+                observer,
+            )?;
+            (r2.result, r2.scene, wall2)
+        }
+        Stage2Method::Mapped => {
+            let started = Instant::now();
+            let mapped = mapped_config(config);
+            let m = spacemap::run(
+                start,
+                target,
+                stage1_renderer,
+                stage2_renderer,
+                &mapped,
+                at_handover.as_ref().map(|(img, _)| img),
+                &stage2_dir,
+                &mut |it| observer.iteration(it),
+            )?;
+            (m.result, m.scene, started.elapsed().as_secs_f64())
+        }
+    };
+    let moves = moves::of(scene, start, &scene2);
+    let r1 = r1.result;
+    let mut stage2 = summary(&r2, wall2, &stage2_config, "stage2");
+    stage2.method = Some(config.method.to_string());
+    if config.method == Stage2Method::Mapped {
+        stage2.population = config.mapped.surrogate_population;
+    }
 
     let comparison = Comparison {
         stage1: summary(&r1, wall1, &stage1_config, "stage1"),
-        stage2: summary(&r2, wall2, &stage2_config, "stage2"),
+        stage2,
         handover: Handover {
             seeded: !config.from_scratch,
             window: (!config.from_scratch).then_some(config.window),
             start_radius: stage2_config.start_radius,
-            deviation_at_handover: at_handover,
+            deviation_at_handover: at_handover.map(|(_, d)| d),
             bounds,
         },
+        moves,
         target: TARGET.into(),
         mask: mask_file,
     };
     run_dir.write_json(COMPARISON, &comparison)?;
     Ok(comparison)
+}
+
+/// The mapped stage 2's settings from the pipeline's: its first trust
+/// region is the DE method's window, its surrogate fits start within the
+/// same start radius, and it draws from stage 2's seed.
+fn mapped_config(config: &PipelineConfig) -> spacemap::MappedConfig {
+    spacemap::MappedConfig {
+        fine_renders: config.mapped.fine_renders,
+        radius: config.window,
+        surrogate_population: config.mapped.surrogate_population,
+        surrogate_generations: config.mapped.surrogate_generations,
+        coarse_jobs: config.stage1.jobs,
+        start_radius: config.start_radius,
+        seed: config.stage2.de.seed,
+        mode: config.mode,
+        interrupt: config.stage2.interrupt.clone(),
+    }
 }
 
 /// Refuses to overwrite the target with itself, clears the directory when
@@ -192,11 +292,33 @@ fn check(scene: &Scene, config: &PipelineConfig) -> Result<()> {
         )));
     }
     let window_ok = config.window > 0.0 && config.window.is_finite();
-    if !config.from_scratch && !window_ok {
+    let mapped = config.method == Stage2Method::Mapped;
+    if (!config.from_scratch || mapped) && !window_ok {
         return Err(Error::Usage(format!(
             "--stage2-window: expected a fraction of the span > 0, got {}",
             config.window
         )));
+    }
+    if mapped {
+        let m = &config.mapped;
+        let min = crate::optimize::MIN_POPULATION;
+        if m.fine_renders < 2 {
+            return Err(Error::Usage(format!(
+                "--stage2-fine-renders: expected at least 2 (the first render and one trial), got {}",
+                m.fine_renders
+            )));
+        }
+        if m.surrogate_population < min {
+            return Err(Error::Usage(format!(
+                "--stage2-surrogate-population: expected at least {min}, got {}",
+                m.surrogate_population
+            )));
+        }
+        if m.surrogate_generations == 0 {
+            return Err(Error::Usage(
+                "--stage2-surrogate-generations: expected at least 1, got 0".into(),
+            ));
+        }
     }
     if let Some(k) = config
         .keep_bounds
@@ -252,13 +374,14 @@ fn handover_render(
     fitted: &Scene,
     target: &FitTarget,
     dir: &RunDir,
-) -> Option<crate::metric::Deviation> {
+) -> Option<(Image, crate::metric::Deviation)> {
     let img = render_one(renderer, fitted, 0).ok()?;
     if img.dimensions() != target.image.dimensions() {
         return None;
     }
     dir.write_image(HANDOVER, &img).ok()?;
-    Some(deviation(&target.image, &img, target.mask.as_ref()))
+    let d = deviation(&target.image, &img, target.mask.as_ref());
+    Some((img, d))
 }
 
 fn summary(r: &FitResult, wall: f64, config: &FitConfig, dir: &str) -> StageSummary {
@@ -274,6 +397,7 @@ fn summary(r: &FitResult, wall: f64, config: &FitConfig, dir: &str) -> StageSumm
         seed: r.seed,
         stop_reason: r.stop_reason.clone(),
         dir: dir.into(),
+        method: None,
     }
 }
 

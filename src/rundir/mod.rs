@@ -41,6 +41,10 @@ pub const MASK: &str = "mask.png";
 /// A pipeline's stage 2: the scene handed over, and its first render.
 pub const INPUT_SCENE: &str = "input_scene.json";
 pub const HANDOVER: &str = "handover.png";
+/// A pipeline's stage 2 by space mapping: its state after every iteration
+/// (what `--resume` continues from) and the fine render at its current point.
+pub const SPACEMAP_STATE: &str = "spacemap.json";
+pub const SPACEMAP_CURRENT: &str = "spacemap_current.png";
 /// A pipeline's comparison of its stages.
 pub const COMPARISON: &str = "comparison.json";
 /// The HTML report and its figures' folder.
