@@ -95,6 +95,8 @@ fn stage2_beats_phong_on_a_cycles_target_with_colour_bleeding() {
             "10",
             "--stage2-generations",
             "6",
+            "--stage2-method",
+            "de",
             "--no-report",
             "-q",
         ],
@@ -167,6 +169,8 @@ fn handover_narrows_bounds_around_stage1_and_seeds_stage2() {
             "10",
             "--stage2-window",
             "0.1",
+            "--stage2-method",
+            "de",
             "-q",
         ],
     );

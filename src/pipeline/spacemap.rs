@@ -92,9 +92,10 @@ pub struct Iteration {
 /// spacemap.json: where a mapped stage 2 stands.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 struct State {
-    /// What the run started from (the handover point's values and the
-    /// seed): a resumed run with other inputs is refused.
+    /// What the run started from (seed and renderers, and the handover
+    /// point): a resumed run with other inputs is refused.
     start: serde_json::Value,
+    start_point: Vec<f64>,
     /// The current point, in the original bounds' unit cube.
     point: Vec<f64>,
     /// The fine deviation at the current point.
@@ -147,21 +148,31 @@ pub fn run(
     let space = ParamSpace::from_scene(start);
     let seed = render_seed(config.seed, 0);
     let identity = serde_json::json!({
-        "params": space.json_values(start),
         "seed": config.seed,
         "fine": fine.name(),
         "coarse": coarse.name(),
     });
+    let start_point = space.unit_of(start);
     let resumed = match config.mode {
         Mode::Resume if dir.file(SPACEMAP_STATE).is_file() => {
             let s: State = dir.read_json(SPACEMAP_STATE, "a scenefit space-mapping state")?;
-            if s.start != identity {
+            // A resumed stage 1 gives its values back through the unit
+            // cube, so they may differ in the last bits.
+            let same_start = s.start_point.len() == start_point.len()
+                && s.start_point
+                    .iter()
+                    .zip(&start_point)
+                    .all(|(a, b)| (a - b).abs() < 1e-9);
+            if s.start != identity || !same_start {
                 return Err(Error::Usage(format!(
                     "{}: the stage-2 state was written for other inputs (stage-1 values, seed or renderers); use --overwrite to start again",
                     dir.file(SPACEMAP_STATE).display()
                 )));
             }
             let img = dir.read_image(SPACEMAP_CURRENT)?;
+            // A larger render budget continues a stage that stopped on it.
+            let mut s = s;
+            s.stop_reason = stop_reason(&s, config);
             Some((s, img))
         }
         _ => None,
@@ -183,7 +194,8 @@ pub fn run(
             let noise_floor = (dev(target, &other)?.average - current.average).abs();
             let s = State {
                 start: identity,
-                point: space.unit_of(start),
+                start_point: start_point.clone(),
+                point: start_point,
                 current,
                 radius: config.radius.clamp(MIN_RADIUS, MAX_RADIUS),
                 noise_floor,

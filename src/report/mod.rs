@@ -21,6 +21,7 @@ pub mod images;
 mod page;
 pub mod plots;
 pub mod population;
+mod stage2;
 mod tradeoffs;
 
 use crate::error::{Error, Result};

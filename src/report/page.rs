@@ -78,8 +78,14 @@ fn summary(page: &mut Page, run: &Run) {
         b.evaluations,
         b.wall_seconds
     ));
+    super::stage2::summary(page, c);
     let h = &c.handover;
-    if h.seeded {
+    if c.stage2.method.as_deref() == Some("mapped") {
+        page.p(&format!(
+            "Handover: stage 2 started at the stage-1 values, with a trust region of ± {:.0} % of each parameter's original span around them, grown or shrunk by how well each step did.",
+            100.0 * h.window.unwrap_or(0.0)
+        ));
+    } else if h.seeded {
         page.p(&format!(
             "Handover: stage 2 searched the stage-1 values ± {:.0} % of each parameter's original span (clamped to the original bounds), \
              its population started within radius {} (unit cube of those bounds) of the stage-1 values, which were individual 0.",
@@ -241,12 +247,20 @@ fn parameters(page: &mut Page, run: &Run) {
                         (Some(a), Some(b)) => change(a, b),
                         _ => "—".into(),
                     },
+                    run.comparison
+                        .as_ref()
+                        .and_then(|c| super::stage2::move_of(c, k))
+                        .unwrap_or_else(|| "—".into()),
                 ]
             })
             .collect();
         let h1 = run.stages[0].title();
         let h2 = run.stages[1].title();
-        page.table(&["Parameter", &h1, &h2, "Change"], &rows);
+        page.table(
+            &["Parameter", &h1, &h2, "Change", "Stage-2 move (% of span)"],
+            &rows,
+        );
+        page.note("Stage-2 move: from where stage 2 started (the handover point) to its result, the largest component, as a fraction of the parameter's original span in the space it is searched in.");
     }
     page.note("Scene units: colours as linear RGB whatever space they were searched in; light intensity in W/sr. Every backend reads these same values and converts them itself (docs/renderers.md).");
 }
@@ -298,11 +312,21 @@ fn cost(page: &mut Page, run: &Run) {
 
 fn convergence(page: &mut Page, run: &Run) -> Result<()> {
     page.h2("Convergence", "convergence");
+    let method = run
+        .comparison
+        .as_ref()
+        .and_then(|c| c.stage2.method.clone());
+    let label = |i: usize, s: &super::data::Stage| match (&method, i) {
+        (Some(m), 1) if m == "mapped" => format!("{}, space mapping", s.title()),
+        (Some(m), 1) => format!("{}, {}", s.title(), m.to_uppercase()),
+        _ => s.title(),
+    };
     let series = |f: &dyn Fn(&super::data::CurvePoint) -> f64| -> Vec<Series> {
         run.stages
             .iter()
-            .map(|s| Series {
-                label: s.title(),
+            .enumerate()
+            .map(|(i, s)| Series {
+                label: label(i, s),
                 points: s
                     .curve
                     .iter()
@@ -311,13 +335,20 @@ fn convergence(page: &mut Page, run: &Run) -> Result<()> {
             })
             .collect()
     };
-    let references: Vec<(String, f64)> = match run.stages.as_slice() {
+    let mut references: Vec<(String, f64)> = match run.stages.as_slice() {
         [s1, _] => vec![(format!("{} final", s1.title()), s1.result.deviation.average)],
         _ => Vec::new(),
     };
+    if let Some(d) = run
+        .comparison
+        .as_ref()
+        .and_then(|c| c.handover.deviation_at_handover)
+    {
+        references.push(("handover".into(), d.average));
+    }
     let by_renders = Convergence {
         title: "Best deviation against renders".into(),
-        x_label: "renders (within the stage)".into(),
+        x_label: "renders (within the stage; stage 2: its own renderer's only)".into(),
         series: series(&|p| p.evaluations as f64),
         references: references.clone(),
     };
@@ -341,6 +372,10 @@ fn convergence(page: &mut Page, run: &Run) -> Result<()> {
         false,
         Some(&svg),
     );
+    if method.as_deref() == Some("mapped") {
+        page.note("Stage 2 by space mapping: one point per iteration; its renders are the stage-2 renderer's only (the stage-1 renderer's surrogate renders are in the table below).");
+        super::stage2::iteration_table(page, run);
+    }
     for s in &run.stages {
         if !s.seconds_measured {
             page.note(&format!(
