@@ -164,6 +164,11 @@ fn resumed_after_the_first_iteration_it_ends_where_a_whole_run_ends() {
     pipeline(dir.path(), "parts", &["--resume"]);
     let a = json(&dir.path().join("whole/stage2/result.json"));
     let b = json(&dir.path().join("parts/stage2/result.json"));
+    let n = |r: &serde_json::Value| r["iterations"].as_array().unwrap().len();
+    assert!(
+        n(&b) > n(&first),
+        "the resumed run did not continue past its first part"
+    );
     // The state file holds the current point as JSON numbers, which give
     // doubles back to within an ulp or so, hence the tolerance.
     for key in ["params", "deviation", "iterations"] {
