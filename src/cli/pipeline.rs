@@ -80,7 +80,8 @@ pub struct PipelineArgs {
 struct MethodArgs {
     /// Stage 2's method: mapped (space mapping: the stage-1 renderer,
     /// corrected by a stage-2 render, searches; the stage-2 renderer checks
-    /// each step) or de (DE with the stage-2 renderer alone).
+    /// each step), de (DE with the stage-2 renderer alone), or both (mapped
+    /// as stage 2, DE too into stage2_de/ for comparison).
     #[arg(long, value_enum, default_value_t = Stage2Method::Mapped)]
     stage2_method: Stage2Method,
     /// Mapped stage 2: stage-2 renders at most.
@@ -151,7 +152,14 @@ pub fn run(a: PipelineArgs) -> Result<()> {
         Some(report::write(&a.output, &ReportOptions::default())?)
     };
     if !a.quiet {
-        for (name, s) in [("stage 1", &c.stage1), ("stage 2", &c.stage2)] {
+        let de = c
+            .stage2_de
+            .iter()
+            .map(|s| ("stage 2, DE for comparison", s));
+        for (name, s) in [("stage 1", &c.stage1), ("stage 2", &c.stage2)]
+            .into_iter()
+            .chain(de)
+        {
             let d = s.deviation;
             println!(
                 "{name} ({}): deviation %R {:.3} %G {:.3} %B {:.3} average {:.3}; {} renders in {:.1} s",

@@ -67,6 +67,10 @@ pub struct Comparison {
     /// How far stage 2 moved each free parameter from where it started.
     #[serde(default)]
     pub moves: Vec<Move>,
+    /// With `--stage2-method both`: the DE stage 2 run for comparison
+    /// (in stage2_de/); `stage2` is then the mapped one.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stage2_de: Option<StageSummary>,
     /// The target and mask copied into the pipeline directory.
     pub target: String,
     #[serde(default, skip_serializing_if = "Option::is_none")]

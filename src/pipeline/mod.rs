@@ -33,7 +33,8 @@ use crate::metric::{deviation, Mask};
 use crate::raster::Image;
 use crate::render::{render_one, Renderer};
 use crate::rundir::{
-    Kind, Mode, RunDir, CHECKPOINT, COMPARISON, HANDOVER, INPUT_SCENE, MASK, STAGE1, STAGE2, TARGET,
+    Kind, Mode, RunDir, CHECKPOINT, COMPARISON, HANDOVER, INPUT_SCENE, MASK, STAGE1, STAGE2,
+    STAGE2_DE, TARGET,
 };
 use crate::scene::Scene;
 use serde::{Deserialize, Serialize};
@@ -73,6 +74,9 @@ pub enum Stage2Method {
     #[default]
     Mapped,
     De,
+    /// Mapped as stage 2, and DE as well into stage2_de/, for comparing
+    /// the two (the report draws both).
+    Both,
 }
 
 impl std::fmt::Display for Stage2Method {
@@ -80,6 +84,7 @@ impl std::fmt::Display for Stage2Method {
         f.write_str(match self {
             Stage2Method::Mapped => "mapped",
             Stage2Method::De => "de",
+            Stage2Method::Both => "both",
         })
     }
 }
@@ -185,7 +190,7 @@ pub fn run(
             )?;
             (r2.result, r2.scene, wall2)
         }
-        Stage2Method::Mapped => {
+        Stage2Method::Mapped | Stage2Method::Both => {
             let started = Instant::now();
             let mapped = mapped_config(config);
             let m = spacemap::run(
@@ -201,11 +206,35 @@ pub fn run(
             (m.result, m.scene, started.elapsed().as_secs_f64())
         }
     };
+    // The DE stage 2 beside the mapped one, for comparison.
+    let stage2_de = if config.method == Stage2Method::Both {
+        let de_dir = run_dir.sub(STAGE2_DE)?;
+        let mut de_config = stage_config(&config.stage2, config.mode, &de_dir);
+        de_config.start_radius = stage2_config.start_radius;
+        observer.stage(2, &stage2_renderer.name(), de_dir.path());
+        let (r, wall) = run_stage(
+            &input,
+            target,
+            stage2_renderer,
+            &de_config,
+            &de_dir,
+            observer,
+        )?;
+        let mut s = summary(&r.result, wall, &de_config, STAGE2_DE);
+        s.method = Some(Stage2Method::De.to_string());
+        Some(s)
+    } else {
+        None
+    };
     let moves = moves::of(scene, start, &scene2);
     let r1 = r1.result;
     let mut stage2 = summary(&r2, wall2, &stage2_config, "stage2");
-    stage2.method = Some(config.method.to_string());
-    if config.method == Stage2Method::Mapped {
+    let method = match config.method {
+        Stage2Method::De => Stage2Method::De,
+        _ => Stage2Method::Mapped,
+    };
+    stage2.method = Some(method.to_string());
+    if method == Stage2Method::Mapped {
         stage2.population = config.mapped.surrogate_population;
     }
 
@@ -220,6 +249,7 @@ pub fn run(
             bounds,
         },
         moves,
+        stage2_de,
         target: TARGET.into(),
         mask: mask_file,
     };
@@ -292,7 +322,7 @@ fn check(scene: &Scene, config: &PipelineConfig) -> Result<()> {
         )));
     }
     let window_ok = config.window > 0.0 && config.window.is_finite();
-    let mapped = config.method == Stage2Method::Mapped;
+    let mapped = config.method != Stage2Method::De;
     if (!config.from_scratch || mapped) && !window_ok {
         return Err(Error::Usage(format!(
             "--stage2-window: expected a fraction of the span > 0, got {}",

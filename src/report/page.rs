@@ -162,6 +162,12 @@ fn table_i(page: &mut Page, run: &Run) {
         .iter()
         .map(|s| deviation_row(&s.title(), &s.result.deviation))
         .collect();
+    if let Some(s) = &run.stage2_de {
+        rows.push(deviation_row(
+            &format!("{}, DE (for comparison)", s.title()),
+            &s.result.deviation,
+        ));
+    }
     if let Some(c) = &run.comparison {
         if let Some(d) = &c.handover.deviation_at_handover {
             rows.push(deviation_row(
@@ -267,19 +273,26 @@ fn parameters(page: &mut Page, run: &Run) {
 
 fn cost(page: &mut Page, run: &Run) {
     page.h2("Time and renders", "cost");
+    let de = run.stage2_de.iter().map(|s| (2, s));
     let rows: Vec<Vec<String>> = run
         .stages
         .iter()
         .enumerate()
+        .chain(de)
         .map(|(i, s)| {
             let r = &s.result;
             let wall = match &run.comparison {
                 Some(c) if i == 0 => c.stage1.wall_seconds,
+                Some(c) if i == 2 => c.stage2_de.as_ref().map_or(0.0, |d| d.wall_seconds),
                 Some(c) => c.stage2.wall_seconds,
                 None => r.wall_seconds,
             };
             vec![
-                s.title(),
+                if i == 2 {
+                    format!("{}, DE (for comparison)", s.title())
+                } else {
+                    s.title()
+                },
                 r.evaluations.to_string(),
                 r.generations.to_string(),
                 format!("{wall:.1}"),
@@ -322,7 +335,8 @@ fn convergence(page: &mut Page, run: &Run) -> Result<()> {
         _ => s.title(),
     };
     let series = |f: &dyn Fn(&super::data::CurvePoint) -> f64| -> Vec<Series> {
-        run.stages
+        let mut v: Vec<Series> = run
+            .stages
             .iter()
             .enumerate()
             .map(|(i, s)| Series {
@@ -333,7 +347,18 @@ fn convergence(page: &mut Page, run: &Run) -> Result<()> {
                     .map(|p| (f(p), p.deviation.average))
                     .collect(),
             })
-            .collect()
+            .collect();
+        if let Some(s) = &run.stage2_de {
+            v.push(Series {
+                label: format!("{}, DE (for comparison)", s.title()),
+                points: s
+                    .curve
+                    .iter()
+                    .map(|p| (f(p), p.deviation.average))
+                    .collect(),
+            });
+        }
+        v
     };
     let mut references: Vec<(String, f64)> = match run.stages.as_slice() {
         [s1, _] => vec![(format!("{} final", s1.title()), s1.result.deviation.average)],

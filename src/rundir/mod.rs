@@ -53,6 +53,9 @@ pub const FIGURES: &str = "figures";
 /// A pipeline's stage directories.
 pub const STAGE1: &str = "stage1";
 pub const STAGE2: &str = "stage2";
+/// A pipeline's DE stage 2 run beside the mapped one for comparison
+/// (`--stage2-method both`).
+pub const STAGE2_DE: &str = "stage2_de";
 /// The lock a run holds on its directory.
 const LOCK: &str = ".scenefit.lock";
 
@@ -103,7 +106,8 @@ impl Kind {
     }
 
     fn owns_dir(self, name: &str) -> bool {
-        name == FIGURES || (self == Kind::Pipeline && (name == STAGE1 || name == STAGE2))
+        name == FIGURES
+            || (self == Kind::Pipeline && (name == STAGE1 || name == STAGE2 || name == STAGE2_DE))
     }
 }
 
