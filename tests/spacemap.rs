@@ -192,3 +192,35 @@ fn close(a: &serde_json::Value, b: &serde_json::Value) -> bool {
         _ => a == b,
     }
 }
+
+#[test]
+fn both_methods_run_side_by_side_and_the_report_draws_both() {
+    let dir = tempfile::tempdir().unwrap();
+    if !setup(dir.path()) {
+        return;
+    }
+    let extra = [
+        "--stage2-method",
+        "both",
+        "--stage2-population",
+        "6",
+        "--stage2-generations",
+        "1",
+    ];
+    pipeline(dir.path(), "run", &extra);
+    let run = dir.path().join("run");
+    let c = json(&run.join("comparison.json"));
+    assert_eq!(c["stage2"]["method"], "mapped");
+    assert_eq!(c["stage2_de"]["method"], "de");
+    assert_eq!(c["stage2_de"]["evaluations"].as_u64(), Some(6 * 2));
+    assert!(run.join("stage2_de/result.json").is_file());
+    let out = scenefit(dir.path(), &["report", "run", "-q"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let html = std::fs::read_to_string(run.join("report.html")).unwrap();
+    assert!(
+        html.contains("DE (for comparison)"),
+        "no DE row in the report"
+    );
+    let svg = std::fs::read_to_string(run.join("fig_convergence_renders.svg")).unwrap();
+    assert!(svg.contains("space mapping") && svg.contains("DE (for comparison)"));
+}
