@@ -157,17 +157,8 @@ pub fn run(
     let mask_file = write_inputs(&run_dir, target, config.mode)?;
 
     // Stage 1: the global search, with the stage's own config as given.
-    let stage1_dir = run_dir.sub(STAGE1)?;
-    observer.stage(1, &stage1_renderer.name(), stage1_dir.path());
-    let stage1_config = stage_config(&config.stage1, config.mode, &stage1_dir);
-    let (r1, wall1) = run_stage(
-        scene,
-        target,
-        stage1_renderer,
-        &stage1_config,
-        &stage1_dir,
-        observer,
-    )?;
+    let (r1, wall1, stage1_config) =
+        run_stage1(scene, target, stage1_renderer, config, &run_dir, observer)?;
 
     // Handover.
     let stage2_dir = run_dir.sub(STAGE2)?;
@@ -178,76 +169,51 @@ pub fn run(
     // Stage 2: the local refinement with the physically based renderer.
     observer.stage(2, &stage2_renderer.name(), stage2_dir.path());
     let start = if config.from_scratch { scene } else { fitted };
+    let renderers = (stage1_renderer, stage2_renderer);
+    let handover_img = at_handover.as_ref().map(|(img, _)| img);
     let (r2, scene2, wall2) = match config.method {
         Stage2Method::De => {
-            let (r2, wall2) = run_stage(
-                &input,
-                target,
-                stage2_renderer,
-                &stage2_config,
-                &stage2_dir,
-                observer,
-            )?;
+            let stage = (&stage2_config, &stage2_dir);
+            let (r2, wall2) =
+                run_stage(&input, target, stage2_renderer, stage.0, stage.1, observer)?;
             (r2.result, r2.scene, wall2)
         }
-        Stage2Method::Mapped | Stage2Method::Both => {
-            let started = Instant::now();
-            let mapped = mapped_config(config);
-            let m = spacemap::run(
-                start,
-                target,
-                stage1_renderer,
-                stage2_renderer,
-                &mapped,
-                at_handover.as_ref().map(|(img, _)| img),
-                &stage2_dir,
-                &mut |it| observer.iteration(it),
-            )?;
-            (m.result, m.scene, started.elapsed().as_secs_f64())
-        }
+        _ => run_mapped(
+            start,
+            target,
+            renderers,
+            config,
+            handover_img,
+            &stage2_dir,
+            observer,
+        )?,
     };
     // The DE stage 2 beside the mapped one, for comparison.
-    let stage2_de = if config.method == Stage2Method::Both {
-        let de_dir = run_dir.sub(STAGE2_DE)?;
-        let mut de_config = stage_config(&config.stage2, config.mode, &de_dir);
-        de_config.start_radius = stage2_config.start_radius;
-        observer.stage(2, &stage2_renderer.name(), de_dir.path());
-        let (r, wall) = run_stage(
+    let stage2_de = match config.method {
+        Stage2Method::Both => Some(de_beside(
+            &run_dir,
             &input,
             target,
             stage2_renderer,
-            &de_config,
-            &de_dir,
+            config,
+            stage2_config.start_radius,
             observer,
-        )?;
-        let mut s = summary(&r.result, wall, &de_config, STAGE2_DE);
-        s.method = Some(Stage2Method::De.to_string());
-        Some(s)
-    } else {
-        None
+        )?),
+        _ => None,
     };
     let moves = moves::of(scene, start, &scene2);
     let r1 = r1.result;
-    let mut stage2 = summary(&r2, wall2, &stage2_config, "stage2");
-    let method = match config.method {
-        Stage2Method::De => Stage2Method::De,
-        _ => Stage2Method::Mapped,
-    };
-    stage2.method = Some(method.to_string());
-    if method == Stage2Method::Mapped {
-        stage2.population = config.mapped.surrogate_population;
-    }
+    let stage2 = stage2_summary(&r2, wall2, &stage2_config, config);
 
     let comparison = Comparison {
         stage1: summary(&r1, wall1, &stage1_config, "stage1"),
         stage2,
-        handover: Handover {
-            seeded: !config.from_scratch,
-            window: (!config.from_scratch).then_some(config.window),
-            start_radius: stage2_config.start_radius,
-            deviation_at_handover: at_handover.map(|(_, d)| d),
+        handover: handover_summary(
+            config,
+            stage2_config.start_radius,
+            at_handover.map(|(_, d)| d),
             bounds,
-        },
+        ),
         moves,
         stage2_de,
         target: TARGET.into(),
@@ -255,6 +221,83 @@ pub fn run(
     };
     run_dir.write_json(COMPARISON, &comparison)?;
     Ok(comparison)
+}
+
+/// Stage 1 in its directory: its outcome, wall-clock seconds and config.
+fn run_stage1(
+    scene: &Scene,
+    target: &FitTarget,
+    renderer: &dyn Renderer,
+    config: &PipelineConfig,
+    run_dir: &RunDir,
+    observer: &mut dyn StageObserver,
+) -> Result<(FitOutcome, f64, FitConfig)> {
+    let dir = run_dir.sub(STAGE1)?;
+    observer.stage(1, &renderer.name(), dir.path());
+    let stage1_config = stage_config(&config.stage1, config.mode, &dir);
+    let (r1, wall1) = run_stage(scene, target, renderer, &stage1_config, &dir, observer)?;
+    Ok((r1, wall1, stage1_config))
+}
+
+/// comparison.json's `handover`.
+fn handover_summary(
+    config: &PipelineConfig,
+    start_radius: Option<f64>,
+    deviation_at_handover: Option<crate::metric::Deviation>,
+    bounds: Vec<handover::Narrowed>,
+) -> Handover {
+    Handover {
+        seeded: !config.from_scratch,
+        window: (!config.from_scratch).then_some(config.window),
+        start_radius,
+        deviation_at_handover,
+        bounds,
+    }
+}
+
+/// The mapped stage 2: its result, fitted scene and wall-clock seconds.
+fn run_mapped(
+    start: &Scene,
+    target: &FitTarget,
+    (coarse, fine): (&dyn Renderer, &dyn Renderer),
+    config: &PipelineConfig,
+    handover: Option<&Image>,
+    dir: &RunDir,
+    observer: &mut dyn StageObserver,
+) -> Result<(FitResult, Scene, f64)> {
+    let started = Instant::now();
+    let m = spacemap::run(
+        start,
+        target,
+        coarse,
+        fine,
+        &mapped_config(config),
+        handover,
+        dir,
+        &mut |it| observer.iteration(it),
+    )?;
+    Ok((m.result, m.scene, started.elapsed().as_secs_f64()))
+}
+
+/// The DE stage 2 run into stage2_de/ beside the mapped one, seeded as
+/// the DE method would be; its summary.
+fn de_beside(
+    run_dir: &RunDir,
+    input: &Scene,
+    target: &FitTarget,
+    renderer: &dyn Renderer,
+    config: &PipelineConfig,
+    start_radius: Option<f64>,
+    observer: &mut dyn StageObserver,
+) -> Result<StageSummary> {
+    let de_dir = run_dir.sub(STAGE2_DE)?;
+    let mut de_config = stage_config(&config.stage2, config.mode, &de_dir);
+    de_config.start_radius = start_radius;
+    observer.stage(2, &renderer.name(), de_dir.path());
+    let (r, wall) = run_stage(input, target, renderer, &de_config, &de_dir, observer)?;
+    let mut s = summary(&r.result, wall, &de_config, STAGE2_DE);
+    s.method = Some(Stage2Method::De.to_string());
+    Ok(s)
 }
 
 /// The mapped stage 2's settings from the pipeline's: its first trust
@@ -412,6 +455,26 @@ fn handover_render(
     dir.write_image(HANDOVER, &img).ok()?;
     let d = deviation(&target.image, &img, target.mask.as_ref());
     Some((img, d))
+}
+
+/// Stage 2's summary, with its method (the mapped one's population is
+/// its surrogate fits').
+fn stage2_summary(
+    r: &FitResult,
+    wall: f64,
+    stage2_config: &FitConfig,
+    config: &PipelineConfig,
+) -> StageSummary {
+    let mut s = summary(r, wall, stage2_config, STAGE2);
+    let method = match config.method {
+        Stage2Method::De => Stage2Method::De,
+        _ => Stage2Method::Mapped,
+    };
+    s.method = Some(method.to_string());
+    if method == Stage2Method::Mapped {
+        s.population = config.mapped.surrogate_population;
+    }
+    s
 }
 
 fn summary(r: &FitResult, wall: f64, config: &FitConfig, dir: &str) -> StageSummary {

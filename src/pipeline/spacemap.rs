@@ -129,6 +129,19 @@ pub struct Mapped {
     pub scene: Scene,
 }
 
+/// What every part of the stage reads.
+struct Ctx<'a> {
+    start: &'a Scene,
+    space: ParamSpace,
+    target: &'a FitTarget,
+    coarse: &'a dyn Renderer,
+    fine: &'a dyn Renderer,
+    config: &'a MappedConfig,
+    dir: &'a RunDir,
+    /// The sampler seed of every fine render but the noise floor's.
+    seed: u64,
+}
+
 /// Runs the mapped stage 2 from `start` (the stage-1 fitted scene, which
 /// holds the original free list and bounds), writing into `dir`.
 /// `handover` is the fine render of `start` already made (seeded 0), used
@@ -145,76 +158,26 @@ pub fn run(
     observer: &mut dyn FnMut(&Iteration),
 ) -> Result<Mapped> {
     let started = Instant::now();
-    let space = ParamSpace::from_scene(start);
-    let seed = render_seed(config.seed, 0);
+    let cx = Ctx {
+        start,
+        space: ParamSpace::from_scene(start),
+        target,
+        coarse,
+        fine,
+        config,
+        dir,
+        seed: render_seed(config.seed, 0),
+    };
     let identity = serde_json::json!({
         "seed": config.seed,
         "fine": fine.name(),
         "coarse": coarse.name(),
     });
-    let start_point = space.unit_of(start);
-    let resumed = match config.mode {
-        Mode::Resume if dir.file(SPACEMAP_STATE).is_file() => {
-            let s: State = dir.read_json(SPACEMAP_STATE, "a scenefit space-mapping state")?;
-            // A resumed stage 1 gives its values back through the unit
-            // cube, so they may differ in the last bits.
-            let same_start = s.start_point.len() == start_point.len()
-                && s.start_point
-                    .iter()
-                    .zip(&start_point)
-                    .all(|(a, b)| (a - b).abs() < 1e-9);
-            if s.start != identity || !same_start {
-                return Err(Error::Usage(format!(
-                    "{}: the stage-2 state was written for other inputs (stage-1 values, seed or renderers); use --overwrite to start again",
-                    dir.file(SPACEMAP_STATE).display()
-                )));
-            }
-            let img = dir.read_image(SPACEMAP_CURRENT)?;
-            // A larger render budget continues a stage that stopped on it.
-            let mut s = s;
-            s.stop_reason = stop_reason(&s, config);
-            Some((s, img))
-        }
-        _ => None,
-    };
-    let (mut state, mut fine_now) = match resumed {
+    let (mut state, mut fine_now) = match resume(&cx, &identity)? {
         Some(r) => r,
-        None => {
-            let img = render_fine(fine, start, seed, "the handover point")?;
-            let current = dev(target, &img)?;
-            let other = match handover {
-                Some(h) => h.clone(),
-                None => render_fine(
-                    fine,
-                    start,
-                    render_seed(config.seed, 1),
-                    "the handover point",
-                )?,
-            };
-            let noise_floor = (dev(target, &other)?.average - current.average).abs();
-            let s = State {
-                start: identity,
-                start_point: start_point.clone(),
-                point: start_point,
-                current,
-                radius: config.radius.clamp(MIN_RADIUS, MAX_RADIUS),
-                noise_floor,
-                fine_renders: if handover.is_some() { 1 } else { 2 },
-                coarse_renders: 0,
-                stalls: 0,
-                seconds: 0.0,
-                iterations: Vec::new(),
-                stop_reason: None,
-            };
-            write_trace_header(dir)?;
-            append_trace(dir, 0, s.fine_renders, 0.0, &s.current)?;
-            dir.write_image(&snapshot_name(0), &img)?;
-            save(dir, &s, &img)?;
-            (s, img)
-        }
+        None => begin(&cx, identity, handover)?,
     };
     let seconds_before = state.seconds;
-    let mut current_scene = space.scene_at(start, &state.point);
     while state.stop_reason.is_none() {
         if config
             .interrupt
@@ -227,65 +190,9 @@ pub fn run(
             )));
         }
         let k = state.iterations.len() + 1;
-        let coarse_now = render_one(coarse, &current_scene, 0)?;
-        let (trial, coarse_renders) = surrogate_step(
-            start,
-            &current_scene,
-            target,
-            coarse,
-            &fine_now,
-            &coarse_now,
-            state.radius,
-            config,
-            k,
-        )?;
-        let predicted = state.current.average - trial.surrogate.average;
-        state.coarse_renders += coarse_renders;
-        let moved = trial.point != state.point && predicted > 0.0;
-        let (accepted, fine_dev, fine_img) = if moved {
-            let trial_scene = space.scene_at(start, &trial.point);
-            state.fine_renders += 1;
-            match render_fine(fine, &trial_scene, seed, "a trial point") {
-                Ok(img) => {
-                    let d = dev(target, &img)?;
-                    (d.average < state.current.average, d, Some(img))
-                }
-                // A failed render is a failed step: the region shrinks.
-                Err(_) => (false, state.current, None),
-            }
-        } else {
-            (false, state.current, None)
-        };
-        let actual = state.current.average - fine_dev.average;
-        let iteration = Iteration {
-            deviation: fine_dev.average,
-            surrogate_deviation: trial.surrogate.average,
-            radius: state.radius,
-            accepted,
-            fine_renders: state.fine_renders,
-            coarse_renders,
-        };
-        // The trust region: the ratio of actual to predicted reduction.
-        let ratio = if predicted > 0.0 {
-            actual / predicted
-        } else {
-            0.0
-        };
-        if !accepted || ratio < 0.25 {
-            state.radius /= 2.0;
-        } else if ratio > 0.75 {
-            state.radius = (state.radius * 2.0).min(MAX_RADIUS);
-        }
-        if accepted {
-            state.point = trial.point;
-            state.current = fine_dev;
-            current_scene = space.scene_at(start, &state.point);
-            fine_now = fine_img.expect("accepted steps have a render");
-        }
-        if actual.max(0.0) <= state.noise_floor {
-            state.stalls += 1;
-        } else {
-            state.stalls = 0;
+        let (iteration, accepted_img) = step(&cx, &mut state, &fine_now, k)?;
+        if let Some(img) = accepted_img {
+            fine_now = img;
         }
         state.seconds = seconds_before + started.elapsed().as_secs_f64();
         state.stop_reason = stop_reason(&state, config);
@@ -295,7 +202,150 @@ pub fn run(
         save(dir, &state, &fine_now)?;
         observer(&iteration);
     }
-    finish(dir, state, current_scene, fine_now, fine, target, config)
+    let scene = cx.space.scene_at(start, &state.point);
+    finish(dir, state, scene, fine_now, fine, target, config)
+}
+
+/// The saved state and current fine render of a resumed stage, or None
+/// when there is nothing to resume.
+fn resume(cx: &Ctx, identity: &serde_json::Value) -> Result<Option<(State, Image)>> {
+    let dir = cx.dir;
+    if !(cx.config.mode == Mode::Resume && dir.file(SPACEMAP_STATE).is_file()) {
+        return Ok(None);
+    }
+    let mut s: State = dir.read_json(SPACEMAP_STATE, "a scenefit space-mapping state")?;
+    // A resumed stage 1 gives its values back through the unit cube, so
+    // they may differ in the last bits.
+    let start_point = cx.space.unit_of(cx.start);
+    let same_start = s.start_point.len() == start_point.len()
+        && s.start_point
+            .iter()
+            .zip(&start_point)
+            .all(|(a, b)| (a - b).abs() < 1e-9);
+    if s.start != *identity || !same_start {
+        return Err(Error::Usage(format!(
+            "{}: the stage-2 state was written for other inputs (stage-1 values, seed or renderers); use --overwrite to start again",
+            dir.file(SPACEMAP_STATE).display()
+        )));
+    }
+    let img = dir.read_image(SPACEMAP_CURRENT)?;
+    // A larger render budget continues a stage that stopped on it.
+    s.stop_reason = stop_reason(&s, cx.config);
+    Ok(Some((s, img)))
+}
+
+/// The first state: the fine render at the start, and the noise floor
+/// from it and a second render with another seed (the handover's).
+fn begin(
+    cx: &Ctx,
+    identity: serde_json::Value,
+    handover: Option<&Image>,
+) -> Result<(State, Image)> {
+    let (start, fine, target) = (cx.start, cx.fine, cx.target);
+    let img = render_fine(fine, start, cx.seed, "the handover point")?;
+    let current = dev(target, &img)?;
+    let other = match handover {
+        Some(h) => h.clone(),
+        None => render_fine(
+            fine,
+            start,
+            render_seed(cx.config.seed, 1),
+            "the handover point",
+        )?,
+    };
+    let noise_floor = (dev(target, &other)?.average - current.average).abs();
+    let start_point = cx.space.unit_of(start);
+    let s = State {
+        start: identity,
+        start_point: start_point.clone(),
+        point: start_point,
+        current,
+        radius: cx.config.radius.clamp(MIN_RADIUS, MAX_RADIUS),
+        noise_floor,
+        fine_renders: if handover.is_some() { 1 } else { 2 },
+        coarse_renders: 0,
+        stalls: 0,
+        seconds: 0.0,
+        iterations: Vec::new(),
+        stop_reason: None,
+    };
+    write_trace_header(cx.dir)?;
+    append_trace(cx.dir, 0, s.fine_renders, 0.0, &s.current)?;
+    cx.dir.write_image(&snapshot_name(0), &img)?;
+    save(cx.dir, &s, &img)?;
+    Ok((s, img))
+}
+
+/// One iteration: the surrogate's optimum in the trust region, its fine
+/// render, and the state moved (or not) and its region resized. Returns
+/// the iteration and, when the step was accepted, the new fine render.
+fn step(
+    cx: &Ctx,
+    state: &mut State,
+    fine_now: &Image,
+    k: usize,
+) -> Result<(Iteration, Option<Image>)> {
+    let current_scene = cx.space.scene_at(cx.start, &state.point);
+    let coarse_now = render_one(cx.coarse, &current_scene, 0)?;
+    let (trial, coarse_renders) = surrogate_step(
+        cx.start,
+        &current_scene,
+        cx.target,
+        cx.coarse,
+        fine_now,
+        &coarse_now,
+        state.radius,
+        cx.config,
+        k,
+    )?;
+    let predicted = state.current.average - trial.surrogate.average;
+    state.coarse_renders += coarse_renders;
+    let moved = trial.point != state.point && predicted > 0.0;
+    let (accepted, fine_dev, fine_img) = if moved {
+        let trial_scene = cx.space.scene_at(cx.start, &trial.point);
+        state.fine_renders += 1;
+        match render_fine(cx.fine, &trial_scene, cx.seed, "a trial point") {
+            Ok(img) => {
+                let d = dev(cx.target, &img)?;
+                (d.average < state.current.average, d, Some(img))
+            }
+            // A failed render is a failed step: the region shrinks.
+            Err(_) => (false, state.current, None),
+        }
+    } else {
+        (false, state.current, None)
+    };
+    let actual = state.current.average - fine_dev.average;
+    let iteration = Iteration {
+        deviation: fine_dev.average,
+        surrogate_deviation: trial.surrogate.average,
+        radius: state.radius,
+        accepted,
+        fine_renders: state.fine_renders,
+        coarse_renders,
+    };
+    // The trust region: the ratio of actual to predicted reduction.
+    let ratio = if predicted > 0.0 {
+        actual / predicted
+    } else {
+        0.0
+    };
+    if !accepted || ratio < 0.25 {
+        state.radius /= 2.0;
+    } else if ratio > 0.75 {
+        state.radius = (state.radius * 2.0).min(MAX_RADIUS);
+    }
+    if actual.max(0.0) <= state.noise_floor {
+        state.stalls += 1;
+    } else {
+        state.stalls = 0;
+    }
+    if !accepted {
+        return Ok((iteration, None));
+    }
+    state.point = trial.point;
+    state.current = fine_dev;
+    Ok((iteration, fine_img))
 }
 
 /// Why the iteration loop stops now, if it does.

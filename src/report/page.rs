@@ -329,37 +329,7 @@ fn convergence(page: &mut Page, run: &Run) -> Result<()> {
         .comparison
         .as_ref()
         .and_then(|c| c.stage2.method.clone());
-    let label = |i: usize, s: &super::data::Stage| match (&method, i) {
-        (Some(m), 1) if m == "mapped" => format!("{}, space mapping", s.title()),
-        (Some(m), 1) => format!("{}, {}", s.title(), m.to_uppercase()),
-        _ => s.title(),
-    };
-    let series = |f: &dyn Fn(&super::data::CurvePoint) -> f64| -> Vec<Series> {
-        let mut v: Vec<Series> = run
-            .stages
-            .iter()
-            .enumerate()
-            .map(|(i, s)| Series {
-                label: label(i, s),
-                points: s
-                    .curve
-                    .iter()
-                    .map(|p| (f(p), p.deviation.average))
-                    .collect(),
-            })
-            .collect();
-        if let Some(s) = &run.stage2_de {
-            v.push(Series {
-                label: format!("{}, DE (for comparison)", s.title()),
-                points: s
-                    .curve
-                    .iter()
-                    .map(|p| (f(p), p.deviation.average))
-                    .collect(),
-            });
-        }
-        v
-    };
+    let series = |f: &dyn Fn(&super::data::CurvePoint) -> f64| curves(run, f);
     let mut references: Vec<(String, f64)> = match run.stages.as_slice() {
         [s1, _] => vec![(format!("{} final", s1.title()), s1.result.deviation.average)],
         _ => Vec::new(),
@@ -410,6 +380,42 @@ fn convergence(page: &mut Page, run: &Run) -> Result<()> {
         }
     }
     Ok(())
+}
+
+/// One curve per stage (and the DE stage 2 beside a mapped one), each
+/// labelled with its method, with `f` of each point as its x.
+fn curves(run: &Run, f: &dyn Fn(&super::data::CurvePoint) -> f64) -> Vec<Series> {
+    let method = run
+        .comparison
+        .as_ref()
+        .and_then(|c| c.stage2.method.clone());
+    let label = |i: usize, s: &super::data::Stage| match (&method, i) {
+        (Some(m), 1) if m == "mapped" => format!("{}, space mapping", s.title()),
+        (Some(m), 1) => format!("{}, {}", s.title(), m.to_uppercase()),
+        _ => s.title(),
+    };
+    let points = |s: &super::data::Stage| -> Vec<(f64, f64)> {
+        s.curve
+            .iter()
+            .map(|p| (f(p), p.deviation.average))
+            .collect()
+    };
+    let mut v: Vec<Series> = run
+        .stages
+        .iter()
+        .enumerate()
+        .map(|(i, s)| Series {
+            label: label(i, s),
+            points: points(s),
+        })
+        .collect();
+    if let Some(s) = &run.stage2_de {
+        v.push(Series {
+            label: format!("{}, DE (for comparison)", s.title()),
+            points: points(s),
+        });
+    }
+    v
 }
 
 fn evolution(page: &mut Page, run: &Run) -> Result<()> {
