@@ -95,6 +95,8 @@ fn stage2_beats_phong_on_a_cycles_target_with_colour_bleeding() {
             "10",
             "--stage2-generations",
             "6",
+            "--stage2-method",
+            "de",
             "--no-report",
             "-q",
         ],
@@ -167,6 +169,8 @@ fn handover_narrows_bounds_around_stage1_and_seeds_stage2() {
             "10",
             "--stage2-window",
             "0.1",
+            "--stage2-method",
+            "de",
             "-q",
         ],
     );
@@ -261,7 +265,13 @@ fn user_mistakes_exit_2_with_one_message() {
     let scene = scene.to_str().unwrap();
     let t = scenefit(dir.path(), &["render", scene, "-o", "target.png"]);
     assert!(t.status.success());
-    let cases: [(&[&str], &str); 5] = [
+    let cases: [(&[&str], &str); 8] = [
+        (&["--stage2-method", "nosuch"], "--stage2-method"),
+        (&["--stage2-fine-renders", "1"], "--stage2-fine-renders"),
+        (
+            &["--stage2-surrogate-population", "2"],
+            "--stage2-surrogate-population",
+        ),
         (&["--stage2", "nosuch"], "--stage2 nosuch"),
         (&["--stage2-window", "0"], "--stage2-window"),
         (&["--stage2-start-radius=-1"], "--stage2-start-radius"),

@@ -1,15 +1,16 @@
 //! `scenefit pipeline SCENE --target IMG -o DIR [--stage2 blender|mitsuba|povray] [--mask M]`
 //! with each stage's search options (`--stage1-population`, …,
 //! `--stage2-generations`, …), the handover's `--stage2-window` and
-//! `--stage2-start-radius`, and `--stage2-from-scratch`. Writes the report
-//! at the end.
+//! `--stage2-start-radius`, `--stage2-from-scratch`, and stage 2's method
+//! (`--stage2-method mapped|de`) with the mapped method's budgets. Writes
+//! the report at the end.
 
 use super::fit::interrupt_flag;
 use super::progress::Progress;
 use super::search::{Search, Stage1, Stage2};
 use crate::error::{Error, Result};
 use crate::fit::{GenerationReport, Observer};
-use crate::pipeline::{self, PipelineConfig, StageObserver};
+use crate::pipeline::{self, Iteration, MappedBudget, PipelineConfig, Stage2Method, StageObserver};
 use crate::render::{from_spec_with, RenderOptions, Renderer};
 use crate::report::{self, ReportOptions};
 use crate::scene::{load_with, Override};
@@ -49,6 +50,8 @@ pub struct PipelineArgs {
     /// Stage 2 without the handover: full bounds, uniform start.
     #[arg(long)]
     stage2_from_scratch: bool,
+    #[command(flatten)]
+    method: Box<MethodArgs>,
     /// Override a scene field: PARAM=JSON.
     #[arg(long = "set", value_name = "PARAM=JSON")]
     set: Vec<Override>,
@@ -69,6 +72,27 @@ pub struct PipelineArgs {
     /// Replace an earlier pipeline's files in the output directory.
     #[arg(long)]
     overwrite: bool,
+}
+
+/// Stage 2's method and the mapped method's budgets (boxed: the command
+/// enum's variants stay of similar size).
+#[derive(Args, Debug)]
+struct MethodArgs {
+    /// Stage 2's method: mapped (space mapping: the stage-1 renderer,
+    /// corrected by a stage-2 render, searches; the stage-2 renderer checks
+    /// each step), de (DE with the stage-2 renderer alone), or both (mapped
+    /// as stage 2, DE too into stage2_de/ for comparison).
+    #[arg(long, value_enum, default_value_t = Stage2Method::Mapped)]
+    stage2_method: Stage2Method,
+    /// Mapped stage 2: stage-2 renders at most.
+    #[arg(long, default_value_t = MappedBudget::default().fine_renders, value_name = "N")]
+    stage2_fine_renders: usize,
+    /// Mapped stage 2: population of each iteration's surrogate fit.
+    #[arg(long, default_value_t = MappedBudget::default().surrogate_population, value_name = "N")]
+    stage2_surrogate_population: usize,
+    /// Mapped stage 2: generations of each iteration's surrogate fit.
+    #[arg(long, default_value_t = MappedBudget::default().surrogate_generations, value_name = "N")]
+    stage2_surrogate_generations: usize,
 }
 
 pub fn run(a: PipelineArgs) -> Result<()> {
@@ -99,6 +123,12 @@ pub fn run(a: PipelineArgs) -> Result<()> {
         from_scratch: a.stage2_from_scratch,
         keep_bounds: a.stage2_keep_bounds.clone(),
         mode: super::fit::run_mode(a.resume, a.overwrite),
+        method: a.method.stage2_method,
+        mapped: MappedBudget {
+            fine_renders: a.method.stage2_fine_renders,
+            surrogate_population: a.method.stage2_surrogate_population,
+            surrogate_generations: a.method.stage2_surrogate_generations,
+        },
     };
     let mut progress = StageProgress {
         quiet: a.quiet,
@@ -122,7 +152,14 @@ pub fn run(a: PipelineArgs) -> Result<()> {
         Some(report::write(&a.output, &ReportOptions::default())?)
     };
     if !a.quiet {
-        for (name, s) in [("stage 1", &c.stage1), ("stage 2", &c.stage2)] {
+        let de = c
+            .stage2_de
+            .iter()
+            .map(|s| ("stage 2, DE for comparison", s));
+        for (name, s) in [("stage 1", &c.stage1), ("stage 2", &c.stage2)]
+            .into_iter()
+            .chain(de)
+        {
             let d = s.deviation;
             println!(
                 "{name} ({}): deviation %R {:.3} %G {:.3} %B {:.3} average {:.3}; {} renders in {:.1} s",
@@ -161,6 +198,19 @@ impl Observer for StageProgress {
 }
 
 impl StageObserver for StageProgress {
+    fn iteration(&mut self, it: &Iteration) {
+        if !self.quiet {
+            eprintln!(
+                "  iteration: radius {:.4}, surrogate {:.3} %, stage-2 render {:.3} %, {} ({} stage-2 renders)",
+                it.radius,
+                it.surrogate_deviation,
+                it.deviation,
+                if it.accepted { "accepted" } else { "rejected" },
+                it.fine_renders
+            );
+        }
+    }
+
     fn stage(&mut self, stage: u32, renderer: &str, dir: &Path) {
         if let Some(b) = self.bar.take() {
             b.finish();

@@ -4,7 +4,9 @@
 //! {"stage1": {"renderer": "phong", "deviation": {"r", "g", "b", "average"},
 //!             "evaluations": 40080, "wall_seconds": 6.1, ...},
 //!  "stage2": {"renderer": "blender", ...},
-//!  "handover": {"seeded": true, "window": 0.15, ...}}
+//!  "handover": {"seeded": true, "window": 0.15, ...},
+//!  "moves": [{"param": "lights.key.intensity", "from": 12.7, "to": 13.1,
+//!             "span_fraction": [0.008]}, ...]}
 //! ```
 //!
 //! The binding keys (read by outside scripts) come first in each stage; the
@@ -14,6 +16,7 @@
 //! in generations only.
 
 use super::handover::Narrowed;
+pub use super::moves::Move;
 use crate::error::Result;
 use crate::metric::Deviation;
 use crate::rundir::{RunDir, COMPARISON};
@@ -34,6 +37,9 @@ pub struct StageSummary {
     pub stop_reason: String,
     /// The stage's run directory, relative to the pipeline directory.
     pub dir: String,
+    /// Stage 2's method: "mapped" (space mapping) or "de".
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub method: Option<String>,
 }
 
 /// How stage 2 was started from stage 1.
@@ -58,6 +64,13 @@ pub struct Comparison {
     pub stage1: StageSummary,
     pub stage2: StageSummary,
     pub handover: Handover,
+    /// How far stage 2 moved each free parameter from where it started.
+    #[serde(default)]
+    pub moves: Vec<Move>,
+    /// With `--stage2-method both`: the DE stage 2 run for comparison
+    /// (in stage2_de/); `stage2` is then the mapped one.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stage2_de: Option<StageSummary>,
     /// The target and mask copied into the pipeline directory.
     pub target: String,
     #[serde(default, skip_serializing_if = "Option::is_none")]

@@ -21,6 +21,7 @@ pub mod images;
 mod page;
 pub mod plots;
 pub mod population;
+mod stage2;
 mod tradeoffs;
 
 use crate::error::{Error, Result};
@@ -45,6 +46,8 @@ pub struct Run {
     pub dir: PathBuf,
     pub stages: Vec<Stage>,
     pub comparison: Option<Comparison>,
+    /// The DE stage 2 run beside the mapped one (`--stage2-method both`).
+    pub stage2_de: Option<Stage>,
     /// The target, or why there is none.
     pub target: std::result::Result<Image, String>,
     pub mask: Option<Mask>,
@@ -80,6 +83,10 @@ fn load(dir: &Path, options: &ReportOptions) -> Result<Run> {
             "{}: neither a fit directory (result.json) nor a pipeline directory (comparison.json); has the run finished?",
             dir.display()
         )));
+    };
+    let stage2_de = match comparison.as_ref().and_then(|c| c.stage2_de.as_ref()) {
+        Some(s) => Some(Stage::load(&dir.join(&s.dir), "Stage 2")?),
+        None => None,
     };
     let target_path = match (&options.target, &comparison) {
         (Some(p), _) => Ok(p.clone()),
@@ -118,6 +125,7 @@ fn load(dir: &Path, options: &ReportOptions) -> Result<Run> {
         dir: dir.to_path_buf(),
         stages,
         comparison,
+        stage2_de,
         target,
         mask,
     })

@@ -78,8 +78,14 @@ fn summary(page: &mut Page, run: &Run) {
         b.evaluations,
         b.wall_seconds
     ));
+    super::stage2::summary(page, c);
     let h = &c.handover;
-    if h.seeded {
+    if c.stage2.method.as_deref() == Some("mapped") {
+        page.p(&format!(
+            "Handover: stage 2 started at the stage-1 values, with a trust region of ± {:.0} % of each parameter's original span around them, grown or shrunk by how well each step did.",
+            100.0 * h.window.unwrap_or(0.0)
+        ));
+    } else if h.seeded {
         page.p(&format!(
             "Handover: stage 2 searched the stage-1 values ± {:.0} % of each parameter's original span (clamped to the original bounds), \
              its population started within radius {} (unit cube of those bounds) of the stage-1 values, which were individual 0.",
@@ -156,6 +162,12 @@ fn table_i(page: &mut Page, run: &Run) {
         .iter()
         .map(|s| deviation_row(&s.title(), &s.result.deviation))
         .collect();
+    if let Some(s) = &run.stage2_de {
+        rows.push(deviation_row(
+            &format!("{}, DE (for comparison)", s.title()),
+            &s.result.deviation,
+        ));
+    }
     if let Some(c) = &run.comparison {
         if let Some(d) = &c.handover.deviation_at_handover {
             rows.push(deviation_row(
@@ -241,31 +253,46 @@ fn parameters(page: &mut Page, run: &Run) {
                         (Some(a), Some(b)) => change(a, b),
                         _ => "—".into(),
                     },
+                    run.comparison
+                        .as_ref()
+                        .and_then(|c| super::stage2::move_of(c, k))
+                        .unwrap_or_else(|| "—".into()),
                 ]
             })
             .collect();
         let h1 = run.stages[0].title();
         let h2 = run.stages[1].title();
-        page.table(&["Parameter", &h1, &h2, "Change"], &rows);
+        page.table(
+            &["Parameter", &h1, &h2, "Change", "Stage-2 move (% of span)"],
+            &rows,
+        );
+        page.note("Stage-2 move: from where stage 2 started (the handover point) to its result, the largest component, as a fraction of the parameter's original span in the space it is searched in.");
     }
     page.note("Scene units: colours as linear RGB whatever space they were searched in; light intensity in W/sr. Every backend reads these same values and converts them itself (docs/renderers.md).");
 }
 
 fn cost(page: &mut Page, run: &Run) {
     page.h2("Time and renders", "cost");
+    let de = run.stage2_de.iter().map(|s| (2, s));
     let rows: Vec<Vec<String>> = run
         .stages
         .iter()
         .enumerate()
+        .chain(de)
         .map(|(i, s)| {
             let r = &s.result;
             let wall = match &run.comparison {
                 Some(c) if i == 0 => c.stage1.wall_seconds,
+                Some(c) if i == 2 => c.stage2_de.as_ref().map_or(0.0, |d| d.wall_seconds),
                 Some(c) => c.stage2.wall_seconds,
                 None => r.wall_seconds,
             };
             vec![
-                s.title(),
+                if i == 2 {
+                    format!("{}, DE (for comparison)", s.title())
+                } else {
+                    s.title()
+                },
                 r.evaluations.to_string(),
                 r.generations.to_string(),
                 format!("{wall:.1}"),
@@ -298,26 +325,25 @@ fn cost(page: &mut Page, run: &Run) {
 
 fn convergence(page: &mut Page, run: &Run) -> Result<()> {
     page.h2("Convergence", "convergence");
-    let series = |f: &dyn Fn(&super::data::CurvePoint) -> f64| -> Vec<Series> {
-        run.stages
-            .iter()
-            .map(|s| Series {
-                label: s.title(),
-                points: s
-                    .curve
-                    .iter()
-                    .map(|p| (f(p), p.deviation.average))
-                    .collect(),
-            })
-            .collect()
-    };
-    let references: Vec<(String, f64)> = match run.stages.as_slice() {
+    let method = run
+        .comparison
+        .as_ref()
+        .and_then(|c| c.stage2.method.clone());
+    let series = |f: &dyn Fn(&super::data::CurvePoint) -> f64| curves(run, f);
+    let mut references: Vec<(String, f64)> = match run.stages.as_slice() {
         [s1, _] => vec![(format!("{} final", s1.title()), s1.result.deviation.average)],
         _ => Vec::new(),
     };
+    if let Some(d) = run
+        .comparison
+        .as_ref()
+        .and_then(|c| c.handover.deviation_at_handover)
+    {
+        references.push(("handover".into(), d.average));
+    }
     let by_renders = Convergence {
         title: "Best deviation against renders".into(),
-        x_label: "renders (within the stage)".into(),
+        x_label: "renders (within the stage; stage 2: its own renderer's only)".into(),
         series: series(&|p| p.evaluations as f64),
         references: references.clone(),
     };
@@ -341,6 +367,10 @@ fn convergence(page: &mut Page, run: &Run) -> Result<()> {
         false,
         Some(&svg),
     );
+    if method.as_deref() == Some("mapped") {
+        page.note("Stage 2 by space mapping: one point per iteration; its renders are the stage-2 renderer's only (the stage-1 renderer's surrogate renders are in the table below).");
+        super::stage2::iteration_table(page, run);
+    }
     for s in &run.stages {
         if !s.seconds_measured {
             page.note(&format!(
@@ -350,6 +380,42 @@ fn convergence(page: &mut Page, run: &Run) -> Result<()> {
         }
     }
     Ok(())
+}
+
+/// One curve per stage (and the DE stage 2 beside a mapped one), each
+/// labelled with its method, with `f` of each point as its x.
+fn curves(run: &Run, f: &dyn Fn(&super::data::CurvePoint) -> f64) -> Vec<Series> {
+    let method = run
+        .comparison
+        .as_ref()
+        .and_then(|c| c.stage2.method.clone());
+    let label = |i: usize, s: &super::data::Stage| match (&method, i) {
+        (Some(m), 1) if m == "mapped" => format!("{}, space mapping", s.title()),
+        (Some(m), 1) => format!("{}, {}", s.title(), m.to_uppercase()),
+        _ => s.title(),
+    };
+    let points = |s: &super::data::Stage| -> Vec<(f64, f64)> {
+        s.curve
+            .iter()
+            .map(|p| (f(p), p.deviation.average))
+            .collect()
+    };
+    let mut v: Vec<Series> = run
+        .stages
+        .iter()
+        .enumerate()
+        .map(|(i, s)| Series {
+            label: label(i, s),
+            points: points(s),
+        })
+        .collect();
+    if let Some(s) = &run.stage2_de {
+        v.push(Series {
+            label: format!("{}, DE (for comparison)", s.title()),
+            points: points(s),
+        });
+    }
+    v
 }
 
 fn evolution(page: &mut Page, run: &Run) -> Result<()> {

@@ -45,6 +45,10 @@ pub const MASK: &str = "mask.png";
 /// A pipeline's stage 2: the scene handed over, and its first render.
 pub const INPUT_SCENE: &str = "input_scene.json";
 pub const HANDOVER: &str = "handover.png";
+/// A pipeline's stage 2 by space mapping: its state after every iteration
+/// (what `--resume` continues from) and the fine render at its current point.
+pub const SPACEMAP_STATE: &str = "spacemap.json";
+pub const SPACEMAP_CURRENT: &str = "spacemap_current.png";
 /// A pipeline's comparison of its stages.
 pub const COMPARISON: &str = "comparison.json";
 /// The HTML report and its figures' folder.
@@ -53,6 +57,9 @@ pub const FIGURES: &str = "figures";
 /// A pipeline's stage directories.
 pub const STAGE1: &str = "stage1";
 pub const STAGE2: &str = "stage2";
+/// A pipeline's DE stage 2 run beside the mapped one for comparison
+/// (`--stage2-method both`).
+pub const STAGE2_DE: &str = "stage2_de";
 /// The lock a run holds on its directory.
 const LOCK: &str = ".scenefit.lock";
 
@@ -108,7 +115,8 @@ impl Kind {
     }
 
     fn owns_dir(self, name: &str) -> bool {
-        name == FIGURES || (self == Kind::Pipeline && (name == STAGE1 || name == STAGE2))
+        name == FIGURES
+            || (self == Kind::Pipeline && (name == STAGE1 || name == STAGE2 || name == STAGE2_DE))
     }
 }
 
