@@ -390,6 +390,7 @@ fn surrogate_step(
 ) -> Result<(Trial, usize)> {
     let corrected = FitTarget {
         image: corrected_target(&target.image, fine_now, coarse_now),
+        levels: None,
         mask: target.mask.clone(),
         path: None,
     };
@@ -563,6 +564,8 @@ fn finish(
         target: target.path.as_ref().map(|p| p.display().to_string()),
         failed_renders: 0,
         identifiability: None,
+        deviation_precise: None,
+        shots: None,
     };
     result.check_finite()?;
     dir.write_json(FITTED_SCENE, &scene)?;
