@@ -170,6 +170,88 @@ struct SetRefits<'a> {
 }
 
 impl SetRefits<'_> {
+    /// Renders `scene` with every photograph's `own` values: the images
+    /// and the set's sum of absolute differences (None: a render failed).
+    fn render(&mut self, shots: &[Shot]) -> Result<Option<(Vec<Image>, f64)>> {
+        let scenes: Vec<Scene> = shots.iter().map(|s| s.scene.clone()).collect();
+        let space = ParamSpace::from_scene(&scenes[0]);
+        let mut session = self
+            .renderer
+            .session(&scenes[0], &space, self.config.jobs)?;
+        self.renders += scenes.len();
+        let mut images = Vec::with_capacity(scenes.len());
+        let mut total = 0.0;
+        for (r, s) in session.render_batch(&scenes, 0).into_iter().zip(shots) {
+            match r {
+                Ok(img) if img.dimensions() == s.target.image.dimensions() => {
+                    total += sad(&s.target.image, &img, s.target.mask.as_ref());
+                    images.push(img);
+                }
+                _ => return Ok(None),
+            }
+        }
+        Ok(Some((images, total)))
+    }
+
+    /// The best of an extension's starts on the set (the extended scene
+    /// included): each start's shared values with every photograph's own
+    /// values, and again with its level matched to the photographs' (every
+    /// free light intensity scaled, per-shot ones included, which changes
+    /// the photographs' own values). The start's scene and own values.
+    fn best_start(
+        &mut self,
+        ext: &effects::Extension,
+        own: &[Params],
+    ) -> Result<(Scene, Vec<Params>)> {
+        if ext.starts.is_empty() {
+            return Ok((ext.scene.clone(), own.to_vec()));
+        }
+        let inputs = self.inputs;
+        let pooled_level = |images: &[&Image]| {
+            let (mut sum, mut n) = (0.0, 0.0);
+            for (img, s) in images.iter().zip(&inputs.shots) {
+                let w = crate::fit::set::counted(&s.target) as f64;
+                sum += w * super::starts::level(img, s.target.mask.as_ref());
+                n += w;
+            }
+            sum / n.max(1.0)
+        };
+        let targets: Vec<&Image> = inputs.shots.iter().map(|s| &s.target.image).collect();
+        let want = pooled_level(&targets);
+        let mut best = (f64::INFINITY, ext.scene.clone(), own.to_vec());
+        for start in std::iter::once(&ext.scene).chain(&ext.starts) {
+            let shots = shots_of(start, inputs, own)?;
+            let Some((images, d)) = self.render(&shots)? else {
+                continue;
+            };
+            if d < best.0 {
+                best = (d, start.clone(), own.to_vec());
+            }
+            let have = pooled_level(&images.iter().collect::<Vec<_>>());
+            if have <= 0.0 {
+                continue;
+            }
+            let space = ParamSpace::from_scene(start);
+            let matched: Vec<Shot> = shots
+                .iter()
+                .map(|s| Shot {
+                    scene: effects::edit::match_level(&s.scene, want / have),
+                    ..s.clone()
+                })
+                .collect();
+            if let Some((_, d)) = self.render(&matched)? {
+                if d < best.0 {
+                    let own_now = matched
+                        .iter()
+                        .map(|s| s.own_space(&space).json_values(&s.scene))
+                        .collect();
+                    best = (d, start.clone(), own_now);
+                }
+            }
+        }
+        Ok((best.1, best.2))
+    }
+
     /// `scene` (with `own` values) refitted over the set.
     fn run(&mut self, scene: &Scene, own: &[Params]) -> Result<SetModel> {
         let shots = shots_of(scene, self.inputs, own)?;
@@ -189,7 +271,7 @@ impl SetRefits<'_> {
                 snapshot_every: usize::MAX / 2,
                 ..FitConfig::default()
             },
-            rounds: 1,
+            rounds: 2,
             warm: true,
         };
         let out = setfit::run_in(scene, &shots, self.renderer, &config, None, &mut ())?;
@@ -285,7 +367,8 @@ pub fn run(inputs: &SetInputs, out: &Path, config: &DiagnoseConfig) -> Result<Se
             let Some(ext) = effects::extend(effect, &model.scene) else {
                 continue;
             };
-            let fitted = fits.run(&ext.scene, &model.own)?;
+            let (start, own) = fits.best_start(&ext, &model.own)?;
+            let fitted = fits.run(&start, &own)?;
             let k = fitted.dim(inputs);
             let candidate = Candidate {
                 effect: effect.name().to_string(),

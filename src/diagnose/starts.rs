@@ -50,7 +50,7 @@ pub fn best_start(
 }
 
 /// The mean linear value over the mask's channel values.
-fn level(img: &Image, mask: Option<&Mask>) -> f64 {
+pub(super) fn level(img: &Image, mask: Option<&Mask>) -> f64 {
     let lut: Vec<f64> = (0..=255u8).map(crate::render::srgb::decode).collect();
     let raw = img.as_raw();
     let (sum, n) = match mask {

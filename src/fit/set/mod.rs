@@ -45,8 +45,9 @@ pub struct SetConfig {
     pub fit: FitConfig,
     /// Shared blocks at most (each followed by a per-shot block).
     pub rounds: usize,
-    /// Every photograph's own values are already fitted (a refit): skip
-    /// the first per-shot block and start every per-shot block around them.
+    /// Every value is already near its fit (a refit from a chosen start):
+    /// skip the first per-shot block and start every block around the
+    /// current values.
     pub warm: bool,
 }
 
@@ -309,10 +310,9 @@ fn shared_block(
     let seed = block_seed(config.fit.de.seed, state.blocks_done, 0);
     let mut problem = SetProblem::new(session.as_mut(), shared.clone(), bases, targets, seed);
     let cfg = block_config(&config.fit, shared.dim(), seed);
-    // The first shared block searches the whole box (the current values one
-    // member of its population): a shared effect such as a camera response
-    // may sit far from where the photographs' own fits left it.
-    let start = if state.shared_blocks == 0 {
+    // A fresh fit's first shared block searches the whole box (the current
+    // values one member of its population): the scene's values are a guess.
+    let start = if state.shared_blocks == 0 && !config.warm {
         Start::Around {
             center: &state.shared,
             radius: 1.0,
