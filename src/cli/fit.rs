@@ -82,7 +82,7 @@ pub fn run(a: FitArgs) -> Result<()> {
     let mut scene = load_with(&a.inputs.scene, &a.set)?;
     crate::scene::nuisance::add(&mut scene, &a.nuisance);
     let target = a.inputs.target(&scene)?;
-    let renderer = from_spec_with(&a.renderer, &a.render_options.options())?;
+    let renderer = from_spec_with(&a.renderer, &a.render_options.options_in(&a.output))?;
     let mut config = a.search.config(renderer.default_jobs())?;
     let file = a.inputs.scene.display().to_string();
     let (w, h) = (scene.image.width, scene.image.height);

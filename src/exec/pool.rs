@@ -161,7 +161,7 @@ impl WorkerPool {
         let shared = Arc::new(Shared { spec, cfg });
         let first = rt.block_on(async {
             tokio::select! {
-                r = Worker::start(&shared.spec, shared.cfg.startup_timeout) => r,
+                r = Worker::start(&shared.spec, &shared.cfg.launcher, shared.cfg.startup_timeout) => r,
                 () = cancel::cancelled() => Err(RenderFailure::new(cancel::MESSAGE)),
             }
         })?;
@@ -234,7 +234,7 @@ impl Slot {
                 }
             }
             if self.worker.is_none() {
-                match Worker::start(&shared.spec, cfg.startup_timeout).await {
+                match Worker::start(&shared.spec, &cfg.launcher, cfg.startup_timeout).await {
                     Ok(w) => self.worker = Some(w),
                     Err(f) => {
                         failures.push(f);

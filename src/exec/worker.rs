@@ -7,7 +7,9 @@
 //! once and the worker is replaced: a line longer than `MAX_LINE`, an
 //! answer to another id, a line that would be an answer but is not JSON.
 
+use super::launcher::Launcher;
 use super::process::{CommandSpec, Group};
+use super::slurm::Task;
 use super::tail::{drain, Tail};
 use super::RenderFailure;
 use serde_json::Value;
@@ -30,6 +32,9 @@ pub struct Worker {
     pub renders: usize,
     /// Where the current request's output starts in `tail`.
     mark: u64,
+    launcher: Launcher,
+    /// The Slurm task it runs as, if it does.
+    task: Option<Task>,
 }
 
 /// Why a request did not succeed.
@@ -105,9 +110,16 @@ async fn read_line<R: AsyncBufRead + Unpin>(r: &mut R) -> std::io::Result<Option
 }
 
 impl Worker {
-    /// Starts `spec` and waits for its ready line.
-    pub async fn start(spec: &CommandSpec, timeout: Duration) -> Result<Worker, RenderFailure> {
+    /// Starts `spec` where `launcher` runs processes and waits for its
+    /// ready line.
+    pub async fn start(
+        spec: &CommandSpec,
+        launcher: &Launcher,
+        timeout: Duration,
+    ) -> Result<Worker, RenderFailure> {
         let fail = |message: String, stderr: String| RenderFailure { message, stderr };
+        let launched = launcher.launch(spec);
+        let spec = &launched.spec;
         let (mut child, group) = spec.spawn(true).map_err(|e| {
             fail(
                 format!("cannot start worker {}: {e}", spec.display()),
@@ -128,6 +140,8 @@ impl Worker {
             renderer: String::new(),
             renders: 0,
             mark: 0,
+            launcher: launcher.clone(),
+            task: launched.task,
         };
         let deadline = Instant::now() + timeout;
         loop {
@@ -333,6 +347,7 @@ impl Worker {
     /// Kills the worker (and its process group) and returns `output()`.
     pub async fn stop(mut self) -> String {
         self.group.kill();
+        self.launcher.cancel(self.task.as_ref());
         let _ = self.child.start_kill();
         let _ = tokio::time::timeout(Duration::from_secs(5), self.child.wait()).await;
         self.output().await
