@@ -63,7 +63,6 @@ KillWait=2
 InactiveLimit=0
 MinJobAge=30
 MaxJobCount=100000
-SchedulerParameters=defer_batch,max_rpc_cnt=0
 NodeName=$HOST NodeAddr=127.0.0.1 CPUs=$cpus RealMemory=$mem State=UNKNOWN
 PartitionName=debug Nodes=$HOST Default=YES MaxTime=INFINITE State=UP OverSubscribe=FORCE:$OVERSUBSCRIBE
 CONF

@@ -46,8 +46,13 @@ pub struct RendererArgs {
     /// Options passed to srun as given, e.g. "--partition=gpu
     /// --time=02:00:00 --gpus-per-task=1" (with --executor slurm).
     #[arg(long, value_name = "ARGS", value_parser = slurm_args, allow_hyphen_values = true)]
-    slurm_args: Option<Vec<String>>,
+    slurm_args: Option<SlurmArgs>,
 }
+
+/// The words of `--slurm-args` (a type of its own: clap would take a
+/// `Vec` for a list of values).
+#[derive(Clone, Debug, Default)]
+struct SlurmArgs(Vec<String>);
 
 impl RendererArgs {
     /// The library's form of these options.
@@ -60,7 +65,7 @@ impl RendererArgs {
             executor: match self.executor {
                 ExecutorName::Local => Executor::Local,
                 ExecutorName::Slurm => Executor::Slurm {
-                    args: self.slurm_args.clone().unwrap_or_default(),
+                    args: self.slurm_args.clone().unwrap_or_default().0,
                 },
             },
             slurm_ledger: None,
@@ -79,8 +84,8 @@ impl RendererArgs {
     }
 }
 
-fn slurm_args(s: &str) -> Result<Vec<String>, String> {
-    slurm::split_args(s)
+fn slurm_args(s: &str) -> Result<SlurmArgs, String> {
+    slurm::split_args(s).map(SlurmArgs)
 }
 
 fn seconds(s: &str) -> Result<Duration, String> {
