@@ -342,3 +342,103 @@ fn the_next_run_cancels_what_a_killed_run_left_and_names_the_jobs() {
         "job {id} still there"
     );
 }
+
+/// The figures of docs/scale-out.md (run by hand, on a quiet machine:
+/// `cargo test --release --test slurm -- --ignored --nocapture figures`):
+/// renders per second of the latency-bound fake worker
+/// (tests/plugins/sleepy.py, 50 ms per render, 32x24) with 1 to 64
+/// workers, local and on Slurm; scenefit's own CPU time per render
+/// (getrusage of this process, apart from its children); a worker's
+/// start-up; and the same with Blender at 2 workers.
+#[test]
+#[ignore]
+fn figures() {
+    use scenefit::exec::Executor;
+    use scenefit::render::{from_spec_with, RenderOptions};
+    use scenefit::scene::{parse, ParamSpace};
+    if !have_slurm() {
+        return;
+    }
+    fn cpu_self() -> f64 {
+        let mut u: libc::rusage = unsafe { std::mem::zeroed() };
+        // SAFETY: getrusage fills the struct we own.
+        unsafe { libc::getrusage(libc::RUSAGE_SELF, &mut u) };
+        let t = |v: libc::timeval| v.tv_sec as f64 + v.tv_usec as f64 * 1e-6;
+        t(u.ru_utime) + t(u.ru_stime)
+    }
+    fn uptime() -> String {
+        std::fs::read_to_string("/proc/loadavg")
+            .map(|s| s.split_whitespace().take(3).collect::<Vec<_>>().join(" "))
+            .unwrap_or_default()
+    }
+    let sizes: Vec<usize> = std::env::var("FIGURE_WORKERS")
+        .unwrap_or_else(|_| "1,8,32,64".into())
+        .split(',')
+        .filter_map(|s| s.trim().parse().ok())
+        .collect();
+    let per_worker: usize = std::env::var("FIGURE_RENDERS_PER_WORKER")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(40);
+    let mut scene = diffuse_scene(1, 1);
+    scene["image"] = serde_json::json!({"width": 32, "height": 24});
+    let sleepy = format!(
+        "worker:python3 {} --sleep 0.05",
+        root().join("tests/plugins/sleepy.py").display()
+    );
+    let mut cases: Vec<(String, usize, String)> = Vec::new();
+    for &n in &sizes {
+        cases.push((sleepy.clone(), n, "32x24".into()));
+    }
+    if std::env::var("FIGURE_BLENDER").is_ok() {
+        cases.push(("blender".into(), 2, "64x48".into()));
+    }
+    println!("renderer | workers | executor | start-up s | renders | renders/s | scenefit CPU ms/render | load");
+    for (spec, n, size) in cases {
+        let (w, h) = size.split_once('x').unwrap();
+        scene["image"] = serde_json::json!({"width": w.parse::<u32>().unwrap(), "height": h.parse::<u32>().unwrap()});
+        let s = parse(&scene.to_string(), "figure scene", &[]).unwrap();
+        let renders = if spec == "blender" {
+            80
+        } else {
+            n * per_worker
+        };
+        for executor in [Executor::Local, Executor::Slurm { args: vec![] }] {
+            let label = if executor == Executor::Local {
+                "local"
+            } else {
+                "slurm"
+            };
+            let opts = RenderOptions {
+                workers: Some(n),
+                executor,
+                ..Default::default()
+            };
+            let r = from_spec_with(&spec, &opts).unwrap();
+            let t0 = Instant::now();
+            let mut session = r.session(&s, &ParamSpace::default(), n).unwrap();
+            let startup = t0.elapsed().as_secs_f64();
+            // every worker started and warm
+            let warm = vec![s.clone(); n * 2];
+            assert!(session.render_batch(&warm, 1).iter().all(|r| r.is_ok()));
+            let batch = vec![s.clone(); renders];
+            let (c0, t0) = (cpu_self(), Instant::now());
+            let out = session.render_batch(&batch, 1);
+            let wall = t0.elapsed().as_secs_f64();
+            let cpu = cpu_self() - c0;
+            assert!(out.iter().all(|r| r.is_ok()));
+            drop(session);
+            let name = if spec == "blender" {
+                "blender"
+            } else {
+                "sleepy 50 ms"
+            };
+            println!(
+                "{name} | {n} | {label} | {startup:.2} | {renders} | {:.0} | {:.3} | {}",
+                renders as f64 / wall,
+                cpu * 1e3 / renders as f64,
+                uptime()
+            );
+        }
+    }
+}

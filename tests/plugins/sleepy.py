@@ -5,7 +5,8 @@ fixed time per render and then writes a flat grey PNG of the scene's size,
 so that what is measured is scenefit's and the executor's overhead, not
 rendering.
 
-    sleepy.py [--sleep SECONDS]     (default 0.05)
+    sleepy.py [--sleep SECONDS]               persistent (default 0.05 s)
+    sleepy.py [--sleep SECONDS] SCENE OUT     one-shot: one render, then exit
 """
 
 import json
@@ -31,10 +32,18 @@ def png(width, height):
 def main():
     pause = 0.05
     args = sys.argv[1:]
-    if len(args) == 2 and args[0] == "--sleep":
+    if len(args) >= 2 and args[0] == "--sleep":
         pause = float(args[1])
-    elif args:
-        sys.exit("usage: sleepy.py [--sleep SECONDS]")
+        args = args[2:]
+    if len(args) == 2:
+        with open(args[0]) as f:
+            image = json.load(f)["image"]
+        time.sleep(pause)
+        with open(args[1], "wb") as f:
+            f.write(png(int(image["width"]), int(image["height"])))
+        return
+    if args:
+        sys.exit("usage: sleepy.py [--sleep SECONDS] [SCENE OUT]")
     images = {}
     out = sys.stdout
     out.write(json.dumps({"ready": True, "renderer": "sleepy"}) + "\n")
