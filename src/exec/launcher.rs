@@ -76,6 +76,13 @@ impl Launcher {
         }
     }
 
+    /// Where Slurm tasks write their stderr: the session's directory.
+    pub fn use_dir(&self, dir: &std::path::Path) {
+        if let Some(s) = &self.slurm {
+            s.use_dir(dir);
+        }
+    }
+
     /// Cancels a task whose local srun was killed (its remote side may
     /// still run, or its job still be queued).
     pub fn cancel(&self, task: Option<&Task>) {

@@ -71,7 +71,14 @@ pub async fn run_process(
             let _ = tokio::time::timeout(PIPE_GRACE, &mut d).await;
         }
     }
-    let text = tail.text();
+    let mut text = tail.text();
+    if let Some(t) = &launched.task {
+        // a Slurm task's stderr is in its file
+        text.push_str(&t.stderr_tail());
+        if let Some(f) = &t.stderr {
+            let _ = std::fs::remove_file(f);
+        }
+    }
     match status {
         Err(_) => Err(RenderFailure {
             message: format!("timed out after {} s and was killed", timeout.as_secs_f64()),

@@ -235,8 +235,12 @@ impl Worker {
         timeout: Duration,
     ) -> Result<(), RequestError> {
         let sent = tokio::time::timeout_at(deadline, async {
-            self.stdin.write_all(line.as_bytes()).await?;
-            self.stdin.write_all(b"\n").await?;
+            // one write: through srun a second small one (the newline)
+            // waited ~40 ms for the first to be acknowledged (measured)
+            let mut bytes = Vec::with_capacity(line.len() + 1);
+            bytes.extend_from_slice(line.as_bytes());
+            bytes.push(b'\n');
+            self.stdin.write_all(&bytes).await?;
             self.stdin.flush().await
         })
         .await;
@@ -341,7 +345,11 @@ impl Worker {
     pub async fn output(&self) -> String {
         // the stderr drain runs on its own task: give it a moment
         tokio::time::sleep(Duration::from_millis(20)).await;
-        self.tail.text_since(self.mark)
+        let text = self.tail.text_since(self.mark);
+        match self.task.as_ref().map(Task::stderr_tail) {
+            Some(err) if !err.trim().is_empty() => format!("{text}{err}"),
+            _ => text,
+        }
     }
 
     /// Kills the worker (and its process group) and returns `output()`.
