@@ -7,7 +7,7 @@
 //! once and the worker is replaced: a line longer than `MAX_LINE`, an
 //! answer to another id, a line that would be an answer but is not JSON.
 
-use super::launcher::Launcher;
+use super::launcher::{Launched, Launcher};
 use super::process::{CommandSpec, Group};
 use super::slurm::Task;
 use super::tail::{drain, Tail};
@@ -119,30 +119,8 @@ impl Worker {
     ) -> Result<Worker, RenderFailure> {
         let fail = |message: String, stderr: String| RenderFailure { message, stderr };
         let launched = launcher.launch(spec);
-        let spec = &launched.spec;
-        let (mut child, group) = spec.spawn(true).map_err(|e| {
-            fail(
-                format!("cannot start worker {}: {e}", spec.display()),
-                String::new(),
-            )
-        })?;
-        let tail = Tail::new();
-        drain(child.stderr.take(), tail.clone());
-        let (Some(stdin), Some(stdout)) = (child.stdin.take(), child.stdout.take()) else {
-            return Err(fail("worker started without pipes".into(), String::new()));
-        };
-        let mut w = Worker {
-            child,
-            group,
-            stdin,
-            stdout: BufReader::new(stdout),
-            tail,
-            renderer: String::new(),
-            renders: 0,
-            mark: 0,
-            launcher: launcher.clone(),
-            task: launched.task,
-        };
+        let spec = &launched.spec.clone();
+        let mut w = Worker::spawn(launched, launcher)?;
         let deadline = Instant::now() + timeout;
         loop {
             match tokio::time::timeout_at(deadline, read_line(&mut w.stdout)).await {
@@ -195,6 +173,31 @@ impl Worker {
                 },
             }
         }
+    }
+
+    /// Starts the process (not yet ready).
+    fn spawn(launched: Launched, launcher: &Launcher) -> Result<Worker, RenderFailure> {
+        let spec = &launched.spec;
+        let (mut child, group) = spec.spawn(true).map_err(|e| {
+            RenderFailure::new(format!("cannot start worker {}: {e}", spec.display()))
+        })?;
+        let tail = Tail::new();
+        drain(child.stderr.take(), tail.clone());
+        let (Some(stdin), Some(stdout)) = (child.stdin.take(), child.stdout.take()) else {
+            return Err(RenderFailure::new("worker started without pipes"));
+        };
+        Ok(Worker {
+            child,
+            group,
+            stdin,
+            stdout: BufReader::new(stdout),
+            tail,
+            renderer: String::new(),
+            renders: 0,
+            mark: 0,
+            launcher: launcher.clone(),
+            task: launched.task,
+        })
     }
 
     /// Sends one request line (which carries `"id": id`) and waits for its answer.
