@@ -17,4 +17,11 @@ if [ -z "${DRJIT_LIBLLVM_PATH:-}" ]; then
   done
 fi
 
+# A single-node Slurm for tests/slurm.rs (needs root: CI runs as root),
+# stopped when the tests end.
+if [ "$(id -u)" = 0 ]; then
+  bash scripts/slurm-local.sh start
+  trap 'bash scripts/slurm-local.sh stop' EXIT
+fi
+
 cargo test --release "$@"

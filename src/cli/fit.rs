@@ -106,7 +106,7 @@ pub fn run(a: FitArgs) -> Result<()> {
         return run_set(&a, &scene, &shots);
     }
     let target = a.inputs.target(&scene, a.quiet)?;
-    let renderer = from_spec_with(&a.renderer, &a.render_options.options())?;
+    let renderer = from_spec_with(&a.renderer, &a.render_options.options_in(&a.output))?;
     let mut config = a.search.config(renderer.default_jobs())?;
     let file = a.inputs.scene.display().to_string();
     let (w, h) = (scene.image.width, scene.image.height);
@@ -147,7 +147,7 @@ pub fn run(a: FitArgs) -> Result<()> {
 
 /// `fit --shots`: one fit of every photograph of a set.
 fn run_set(a: &FitArgs, scene: &Scene, shots: &[crate::shots::Shot]) -> Result<()> {
-    let renderer = from_spec_with(&a.renderer, &a.render_options.options())?;
+    let renderer = from_spec_with(&a.renderer, &a.render_options.options_in(&a.output))?;
     let mut config = a.search.config(renderer.default_jobs())?;
     let file = a.inputs.scene.display().to_string();
     let (w, h) = (scene.image.width, scene.image.height);

@@ -101,7 +101,7 @@ pub fn run(a: PipelineArgs) -> Result<()> {
     }
     let scene = load_with(&a.inputs.scene, &a.set)?;
     let target = a.inputs.target(&scene, a.quiet)?;
-    let opts = a.render_options.options();
+    let opts = a.render_options.options_in(&a.output);
     let r1 = renderer(&a.stage1, "--stage1", &opts)?;
     let r2 = renderer(&a.stage2, "--stage2", &opts)?;
     let interrupt = interrupt_flag();

@@ -1,11 +1,25 @@
 //! The options of the process-backed renderers, shared by every command
 //! that renders (render, fit, pipeline, diagnose). Each overrides its
-//! environment variable, which overrides the backend's default.
+//! environment variable, which overrides the backend's default. Also where
+//! the renderer processes run (`--executor`, `--workers`, `--slurm-args`).
 
+use crate::exec::slurm;
+use crate::exec::Executor;
 use crate::render::RenderOptions;
-use clap::Args;
-use std::path::PathBuf;
+use clap::{Args, ValueEnum};
+use std::path::{Path, PathBuf};
 use std::time::Duration;
+
+/// Where the renderer processes run.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
+enum ExecutorName {
+    /// Child processes of scenefit.
+    #[default]
+    Local,
+    /// Slurm tasks, each started with srun (a job step inside an
+    /// allocation, a job of its own outside one).
+    Slurm,
+}
 
 #[derive(Args, Debug, Clone, Default)]
 pub struct RendererArgs {
@@ -21,7 +35,24 @@ pub struct RendererArgs {
     /// SCENEFIT_PYTHON).
     #[arg(long, value_name = "PATH")]
     python: Option<PathBuf>,
+    /// Where the renderer processes run: here, or as Slurm tasks through
+    /// srun.
+    #[arg(long, value_enum, default_value_t = ExecutorName::Local)]
+    executor: ExecutorName,
+    /// Renderer workers (or one-shot processes) at once (default: as many
+    /// as --jobs renders at once).
+    #[arg(long, value_name = "N", value_parser = at_least_one)]
+    workers: Option<usize>,
+    /// Options passed to srun as given, e.g. "--partition=gpu
+    /// --time=02:00:00 --gpus-per-task=1" (with --executor slurm).
+    #[arg(long, value_name = "ARGS", value_parser = slurm_args, allow_hyphen_values = true)]
+    slurm_args: Option<SlurmArgs>,
 }
+
+/// The words of `--slurm-args` (a type of its own: clap would take a
+/// `Vec` for a list of values).
+#[derive(Clone, Debug, Default)]
+struct SlurmArgs(Vec<String>);
 
 impl RendererArgs {
     /// The library's form of these options.
@@ -30,8 +61,31 @@ impl RendererArgs {
             render_timeout: self.render_timeout,
             worker_max_renders: self.worker_max_renders,
             python: self.python.clone(),
+            workers: self.workers,
+            executor: match self.executor {
+                ExecutorName::Local => Executor::Local,
+                ExecutorName::Slurm => Executor::Slurm {
+                    args: self.slurm_args.clone().unwrap_or_default().0,
+                },
+            },
+            slurm_ledger: None,
         }
     }
+
+    /// `options()` for a run into `run_dir`: its Slurm jobs are recorded
+    /// there, and what a killed run there left on Slurm is cancelled now.
+    pub fn options_in(&self, run_dir: &Path) -> RenderOptions {
+        let ledger = run_dir.join(crate::rundir::SLURM_JOBS);
+        slurm::clean_ledger(&ledger);
+        RenderOptions {
+            slurm_ledger: Some(ledger),
+            ..self.options()
+        }
+    }
+}
+
+fn slurm_args(s: &str) -> Result<SlurmArgs, String> {
+    slurm::split_args(s).map(SlurmArgs)
 }
 
 fn seconds(s: &str) -> Result<Duration, String> {

@@ -1,4 +1,5 @@
-//! Where renderer processes run: a local pool on tokio. One-shot renderers
+//! Where renderer processes run: a pool on tokio, of local processes or of
+//! Slurm tasks (`launcher`, `slurm`). One-shot renderers
 //! get one process per render (`oneshot`), persistent workers answer
 //! JSON-lines requests (`worker`, `pool`); both with a concurrency limit, a
 //! per-render timeout, one retry, stderr drained and kept (`tail`), and
@@ -13,18 +14,22 @@
 
 pub mod cancel;
 pub mod discover;
+pub mod launcher;
 pub mod oneshot;
 pub mod output;
 pub mod pool;
 pub mod process;
 pub mod result;
+pub mod slurm;
 pub mod stats;
 pub mod tail;
 pub mod watchdog;
 pub mod worker;
 
 use crate::error::{Error, Result};
+pub use launcher::{Executor, Launcher};
 pub use result::{RenderFailure, RenderResult};
+use std::path::PathBuf;
 use std::time::Duration;
 
 /// Environment variable: per-render timeout in seconds (all backends).
@@ -46,6 +51,8 @@ pub struct ExecConfig {
     pub max_renders: usize,
     /// A failed render is tried again this many times.
     pub retries: usize,
+    /// Where the processes run (here, or as Slurm tasks).
+    pub launcher: Launcher,
 }
 
 /// What the caller chose over the environment and the backend's defaults
@@ -54,6 +61,11 @@ pub struct ExecConfig {
 pub struct ExecOverrides {
     pub render_timeout: Option<Duration>,
     pub max_renders: Option<usize>,
+    /// Processes or workers at once, over what the session asks for.
+    pub workers: Option<usize>,
+    pub executor: Executor,
+    /// The run directory's record of the run's Slurm jobs.
+    pub slurm_ledger: Option<PathBuf>,
 }
 
 impl ExecConfig {
@@ -80,12 +92,18 @@ impl ExecConfig {
         startup_timeout: Duration,
         over: &ExecOverrides,
     ) -> Result<ExecConfig> {
+        if over.workers == Some(0) {
+            return Err(Error::Usage(
+                "workers: expected a whole number of workers >= 1, e.g. 8".into(),
+            ));
+        }
         let mut c = ExecConfig {
-            jobs: jobs.max(1),
+            jobs: over.workers.unwrap_or(jobs).max(1),
             render_timeout,
             startup_timeout,
             max_renders: 200,
             retries: 1,
+            launcher: Launcher::default(),
         };
         c.apply_env(over)?;
         if let Some(t) = over.render_timeout {
@@ -104,6 +122,7 @@ impl ExecConfig {
             }
             c.max_renders = n;
         }
+        c.launcher = Launcher::new(&over.executor, over.slurm_ledger.clone())?;
         Ok(c)
     }
 
@@ -177,15 +196,18 @@ mod tests {
         let over = ExecOverrides {
             render_timeout: Some(Duration::from_secs(3)),
             max_renders: Some(5),
+            workers: Some(4),
+            ..Default::default()
         };
         let c = ExecConfig::new(2, d, d, &over).unwrap();
         assert_eq!(
-            (c.render_timeout, c.max_renders),
-            (Duration::from_secs(3), 5)
+            (c.render_timeout, c.max_renders, c.jobs),
+            (Duration::from_secs(3), 5, 4)
         );
+        assert!(!c.launcher.is_slurm());
         let zero = ExecOverrides {
             render_timeout: Some(Duration::ZERO),
-            max_renders: None,
+            ..Default::default()
         };
         let e = ExecConfig::new(2, d, d, &zero).unwrap_err().to_string();
         assert!(e.contains("render timeout") && !e.contains("--"), "{e}");

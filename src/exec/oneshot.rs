@@ -1,6 +1,7 @@
 //! One process per render (POV-Ray, `cmd:TEMPLATE` plug-ins): up to `jobs`
 //! at once, each with a timeout, its output checked, a failure retried once.
 
+use super::launcher::Launcher;
 use super::process::CommandSpec;
 use super::tail::{drain, Tail};
 use super::{output, pool, ExecConfig};
@@ -22,9 +23,15 @@ pub struct OneShotJob {
 /// when something it started still holds them.
 const PIPE_GRACE: Duration = Duration::from_millis(500);
 
-/// Runs `spec` to its end; Ok when it exits with status 0. The error keeps
-/// what it printed.
-pub async fn run_process(spec: &CommandSpec, timeout: Duration) -> Result<String, RenderFailure> {
+/// Runs `spec` to its end, where `launcher` runs processes; Ok when it
+/// exits with status 0. The error keeps what it printed.
+pub async fn run_process(
+    spec: &CommandSpec,
+    launcher: &Launcher,
+    timeout: Duration,
+) -> Result<String, RenderFailure> {
+    let launched = launcher.launch(spec);
+    let spec = &launched.spec;
     // `group` kills whatever the process left running when this returns
     let (mut child, group) = spec.spawn(false).map_err(|e| RenderFailure {
         message: format!("cannot start {}: {e}", spec.display()),
@@ -56,6 +63,7 @@ pub async fn run_process(spec: &CommandSpec, timeout: Duration) -> Result<String
     }
     if status.is_err() || lingering {
         group.kill();
+        launcher.cancel(launched.task.as_ref());
         let _ = child.start_kill();
         let _ = tokio::time::timeout(Duration::from_secs(5), child.wait()).await;
         // collect what it printed last
@@ -63,7 +71,14 @@ pub async fn run_process(spec: &CommandSpec, timeout: Duration) -> Result<String
             let _ = tokio::time::timeout(PIPE_GRACE, &mut d).await;
         }
     }
-    let text = tail.text();
+    let mut text = tail.text();
+    if let Some(t) = &launched.task {
+        // a Slurm task's stderr is in its file
+        text.push_str(&t.stderr_tail());
+        if let Some(f) = &t.stderr {
+            let _ = std::fs::remove_file(f);
+        }
+    }
     match status {
         Err(_) => Err(RenderFailure {
             message: format!("timed out after {} s and was killed", timeout.as_secs_f64()),
@@ -96,7 +111,7 @@ pub async fn render(job: &OneShotJob, cfg: &ExecConfig) -> RenderResult {
     let mut failures = Vec::new();
     for _ in 0..=cfg.retries {
         output::remove(&job.output);
-        let result = match run_process(&job.command, cfg.render_timeout).await {
+        let result = match run_process(&job.command, &cfg.launcher, cfg.render_timeout).await {
             Ok(text) => {
                 output::read(&job.output, job.width, job.height).map_err(|m| RenderFailure {
                     message: format!("exited 0 but {m}"),

@@ -159,11 +159,32 @@ impl WorkerPool {
     ) -> Result<WorkerPool, RenderFailure> {
         let n = cfg.jobs.max(1);
         let shared = Arc::new(Shared { spec, cfg });
+        // on a cluster a task can die as it starts (preempted, cancelled,
+        // its node lost): that costs a retry, not the run
+        let tries = if shared.cfg.launcher.is_slurm() {
+            1 + shared.cfg.retries
+        } else {
+            1
+        };
         let first = rt.block_on(async {
-            tokio::select! {
-                r = Worker::start(&shared.spec, shared.cfg.startup_timeout) => r,
-                () = cancel::cancelled() => Err(RenderFailure::new(cancel::MESSAGE)),
+            let mut failures = Vec::new();
+            for _ in 0..tries {
+                let started = tokio::select! {
+                    r = Worker::start(&shared.spec, &shared.cfg.launcher, shared.cfg.startup_timeout) => r,
+                    () = cancel::cancelled() => return Err(RenderFailure::new(cancel::MESSAGE)),
+                };
+                match started {
+                    Ok(w) => return Ok(w),
+                    // Slurm refused the request itself (bad partition,
+                    // account, limits): asking again gives the same
+                    Err(f) if f.stderr.contains("Unable to allocate resources") => {
+                        failures.push(f);
+                        break;
+                    }
+                    Err(f) => failures.push(f),
+                }
             }
+            Err(combine(failures))
         })?;
         let renderer = first.renderer.clone();
         let mut slots = vec![Slot {
@@ -234,7 +255,7 @@ impl Slot {
                 }
             }
             if self.worker.is_none() {
-                match Worker::start(&shared.spec, cfg.startup_timeout).await {
+                match Worker::start(&shared.spec, &cfg.launcher, cfg.startup_timeout).await {
                     Ok(w) => self.worker = Some(w),
                     Err(f) => {
                         failures.push(f);

@@ -2,9 +2,11 @@
 //! destructor runs: a small process (scenefit re-executed with the hidden
 //! first argument `WATCHDOG_ARG`) holds a pipe from scenefit, on which
 //! scenefit records the process group of every renderer it starts (and
-//! forgets it when it is killed) and every run directory. When the pipe
-//! closes, however scenefit ended, the watchdog kills the groups still
-//! recorded and removes the directories, then exits.
+//! forgets it when it is killed), every run directory, and the task-name
+//! prefix of every Slurm session. When the pipe closes, however scenefit
+//! ended, the watchdog kills the groups still recorded, cancels the Slurm
+//! tasks still running under the prefixes, and removes the directories,
+//! then exits.
 //!
 //! It is off unless `enable()` is called (the command line does), so that
 //! programs using the library are not re-executed, and it starts only
@@ -100,6 +102,20 @@ pub fn forget_dir(dir: &Path) {
     }
 }
 
+/// Records the task-name prefix of a Slurm session (`super::slurm`).
+pub fn watch_slurm(prefix: &str) {
+    if !prefix.contains('\n') {
+        send(&format!("+s{prefix}"));
+    }
+}
+
+/// Forgets a Slurm session whose tasks were cancelled.
+pub fn forget_slurm(prefix: &str) {
+    if !prefix.contains('\n') {
+        send(&format!("-s{prefix}"));
+    }
+}
+
 /// The watchdog's main: reads records from stdin to its end, then cleans up.
 pub fn serve() -> i32 {
     // SAFETY: setting signal dispositions to SIG_IGN touches no memory of ours.
@@ -110,6 +126,7 @@ pub fn serve() -> i32 {
     }
     let mut groups = BTreeSet::new();
     let mut dirs = BTreeSet::new();
+    let mut slurm = BTreeSet::new();
     for line in std::io::stdin().lock().lines() {
         let Ok(line) = line else { break };
         let (op, rest) = line.split_at(line.len().min(2));
@@ -123,6 +140,12 @@ pub fn serve() -> i32 {
                 if let Ok(g) = rest.parse::<i32>() {
                     groups.remove(&g);
                 }
+            }
+            "+s" => {
+                slurm.insert(rest.to_string());
+            }
+            "-s" => {
+                slurm.remove(rest);
             }
             "+d" => {
                 dirs.insert(PathBuf::from(rest));
@@ -141,6 +164,9 @@ pub fn serve() -> i32 {
             }
         }
     }
+    // the srun clients are dead now; their remote tasks may not be
+    let prefixes: Vec<String> = slurm.into_iter().collect();
+    super::slurm::cancel_prefixes(&prefixes);
     for d in dirs {
         let _ = std::fs::remove_dir_all(d);
     }

@@ -7,7 +7,9 @@
 //! once and the worker is replaced: a line longer than `MAX_LINE`, an
 //! answer to another id, a line that would be an answer but is not JSON.
 
+use super::launcher::{Launched, Launcher};
 use super::process::{CommandSpec, Group};
+use super::slurm::Task;
 use super::tail::{drain, Tail};
 use super::RenderFailure;
 use serde_json::Value;
@@ -30,6 +32,9 @@ pub struct Worker {
     pub renders: usize,
     /// Where the current request's output starts in `tail`.
     mark: u64,
+    launcher: Launcher,
+    /// The Slurm task it runs as, if it does.
+    task: Option<Task>,
 }
 
 /// Why a request did not succeed.
@@ -105,30 +110,17 @@ async fn read_line<R: AsyncBufRead + Unpin>(r: &mut R) -> std::io::Result<Option
 }
 
 impl Worker {
-    /// Starts `spec` and waits for its ready line.
-    pub async fn start(spec: &CommandSpec, timeout: Duration) -> Result<Worker, RenderFailure> {
+    /// Starts `spec` where `launcher` runs processes and waits for its
+    /// ready line.
+    pub async fn start(
+        spec: &CommandSpec,
+        launcher: &Launcher,
+        timeout: Duration,
+    ) -> Result<Worker, RenderFailure> {
         let fail = |message: String, stderr: String| RenderFailure { message, stderr };
-        let (mut child, group) = spec.spawn(true).map_err(|e| {
-            fail(
-                format!("cannot start worker {}: {e}", spec.display()),
-                String::new(),
-            )
-        })?;
-        let tail = Tail::new();
-        drain(child.stderr.take(), tail.clone());
-        let (Some(stdin), Some(stdout)) = (child.stdin.take(), child.stdout.take()) else {
-            return Err(fail("worker started without pipes".into(), String::new()));
-        };
-        let mut w = Worker {
-            child,
-            group,
-            stdin,
-            stdout: BufReader::new(stdout),
-            tail,
-            renderer: String::new(),
-            renders: 0,
-            mark: 0,
-        };
+        let launched = launcher.launch(spec);
+        let spec = &launched.spec.clone();
+        let mut w = Worker::spawn(launched, launcher)?;
         let deadline = Instant::now() + timeout;
         loop {
             match tokio::time::timeout_at(deadline, read_line(&mut w.stdout)).await {
@@ -183,6 +175,31 @@ impl Worker {
         }
     }
 
+    /// Starts the process (not yet ready).
+    fn spawn(launched: Launched, launcher: &Launcher) -> Result<Worker, RenderFailure> {
+        let spec = &launched.spec;
+        let (mut child, group) = spec.spawn(true).map_err(|e| {
+            RenderFailure::new(format!("cannot start worker {}: {e}", spec.display()))
+        })?;
+        let tail = Tail::new();
+        drain(child.stderr.take(), tail.clone());
+        let (Some(stdin), Some(stdout)) = (child.stdin.take(), child.stdout.take()) else {
+            return Err(RenderFailure::new("worker started without pipes"));
+        };
+        Ok(Worker {
+            child,
+            group,
+            stdin,
+            stdout: BufReader::new(stdout),
+            tail,
+            renderer: String::new(),
+            renders: 0,
+            mark: 0,
+            launcher: launcher.clone(),
+            task: launched.task,
+        })
+    }
+
     /// Sends one request line (which carries `"id": id`) and waits for its answer.
     pub async fn request(
         &mut self,
@@ -221,8 +238,12 @@ impl Worker {
         timeout: Duration,
     ) -> Result<(), RequestError> {
         let sent = tokio::time::timeout_at(deadline, async {
-            self.stdin.write_all(line.as_bytes()).await?;
-            self.stdin.write_all(b"\n").await?;
+            // one write: through srun a second small one (the newline)
+            // waited ~40 ms for the first to be acknowledged (measured)
+            let mut bytes = Vec::with_capacity(line.len() + 1);
+            bytes.extend_from_slice(line.as_bytes());
+            bytes.push(b'\n');
+            self.stdin.write_all(&bytes).await?;
             self.stdin.flush().await
         })
         .await;
@@ -327,12 +348,17 @@ impl Worker {
     pub async fn output(&self) -> String {
         // the stderr drain runs on its own task: give it a moment
         tokio::time::sleep(Duration::from_millis(20)).await;
-        self.tail.text_since(self.mark)
+        let text = self.tail.text_since(self.mark);
+        match self.task.as_ref().map(Task::stderr_tail) {
+            Some(err) if !err.trim().is_empty() => format!("{text}{err}"),
+            _ => text,
+        }
     }
 
     /// Kills the worker (and its process group) and returns `output()`.
     pub async fn stop(mut self) -> String {
         self.group.kill();
+        self.launcher.cancel(self.task.as_ref());
         let _ = self.child.start_kill();
         let _ = tokio::time::timeout(Duration::from_secs(5), self.child.wait()).await;
         self.output().await

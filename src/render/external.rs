@@ -76,7 +76,9 @@ pub fn session_dir(
     opts: &RenderOptions,
 ) -> Result<(ExecConfig, TempDir)> {
     let cfg = ExecConfig::new(jobs, render_timeout, startup_timeout, &opts.exec())?;
-    Ok((cfg, run_dir()?))
+    let dir = run_dir()?;
+    cfg.launcher.use_dir(dir.path());
+    Ok((cfg, dir))
 }
 
 /// [`session_dir`] with a Python worker written into the directory as

@@ -16,7 +16,7 @@ pub mod pov_sdl;
 pub mod povray;
 
 use crate::error::{Error, Result};
-use crate::exec::ExecOverrides;
+use crate::exec::{ExecOverrides, Executor};
 use crate::scene::{ParamSpace, Scene};
 use std::path::PathBuf;
 use std::time::Duration;
@@ -69,6 +69,12 @@ pub struct RenderOptions {
     pub worker_max_renders: Option<usize>,
     /// The Python that runs the Mitsuba worker.
     pub python: Option<PathBuf>,
+    /// Renderer processes or workers at once, over the session's number.
+    pub workers: Option<usize>,
+    /// Where renderer processes run (local, or Slurm tasks).
+    pub executor: Executor,
+    /// The run directory's record of its Slurm jobs (`rundir::SLURM_JOBS`).
+    pub slurm_ledger: Option<PathBuf>,
 }
 
 impl RenderOptions {
@@ -77,6 +83,9 @@ impl RenderOptions {
         ExecOverrides {
             render_timeout: self.render_timeout,
             max_renders: self.worker_max_renders,
+            workers: self.workers,
+            executor: self.executor.clone(),
+            slurm_ledger: self.slurm_ledger.clone(),
         }
     }
 }

@@ -25,6 +25,9 @@ use std::path::{Path, PathBuf};
 pub const RESULT: &str = "result.json";
 /// fitted_scene.json: the scene with the fitted values in place.
 pub const FITTED_SCENE: &str = "fitted_scene.json";
+/// slurm-jobs.txt: the task-name prefixes of the run's Slurm sessions, so
+/// that a later run in the directory cancels what a killed one left.
+pub const SLURM_JOBS: &str = "slurm-jobs.txt";
 /// best.png: the best render.
 pub const BEST: &str = "best.png";
 /// progress.txt: a line every few generations.
