@@ -17,4 +17,3 @@ pub mod render;
 pub mod report;
 pub mod rundir;
 pub mod scene;
-pub mod shots;

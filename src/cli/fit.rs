@@ -95,7 +95,7 @@ pub fn run(a: FitArgs) -> Result<()> {
     let mut scene = load_with(&a.inputs.scene, &a.set)?;
     crate::scene::nuisance::add(&mut scene, &a.nuisance);
     if let Some(shots) = &a.inputs.shots {
-        let (shots, notes) = crate::shots::load(shots, &scene)?;
+        let (shots, notes) = crate::fit::set::shots::load(shots, &scene)?;
         if let (Some(first), false) = (notes.first(), a.quiet) {
             eprintln!(
                 "--shots: saturated pixels left out of the fit in {} of {} photographs (first: {first})",
@@ -146,7 +146,7 @@ pub fn run(a: FitArgs) -> Result<()> {
 }
 
 /// `fit --shots`: one fit of every photograph of a set.
-fn run_set(a: &FitArgs, scene: &Scene, shots: &[crate::shots::Shot]) -> Result<()> {
+fn run_set(a: &FitArgs, scene: &Scene, shots: &[crate::fit::set::shots::Shot]) -> Result<()> {
     let renderer = from_spec_with(&a.renderer, &a.render_options.options_in(&a.output))?;
     let mut config = a.search.config(renderer.default_jobs())?;
     let file = a.inputs.scene.display().to_string();

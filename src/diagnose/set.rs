@@ -15,6 +15,7 @@ use super::residual::Residual;
 use super::selection::{bic, choose, sad, samples};
 use super::{Candidate, DiagnoseConfig, Diagnosis, UNEXPLAINED};
 use crate::error::{Error, Result};
+use crate::fit::set::shots::Shot;
 use crate::fit::set::{self as setfit, SetConfig};
 use crate::fit::{FitConfig, FitResult};
 use crate::metric::{deviation, Deviation};
@@ -24,7 +25,6 @@ use crate::render::{from_spec_with, Renderer};
 use crate::rundir::{RunDir, FITTED_SCENE, SHOTS};
 use crate::scene::load::with_overrides;
 use crate::scene::{Override, ParamSpace, Scene};
-use crate::shots::Shot;
 use serde::Serialize;
 use std::path::Path;
 use std::time::Instant;
@@ -52,7 +52,7 @@ impl SetInputs {
             return Ok(None);
         };
         let scene = crate::scene::load(&dir.join(FITTED_SCENE))?;
-        let (shots, _) = crate::shots::load(&dir.join(SHOTS), &scene)?;
+        let (shots, _) = crate::fit::set::shots::load(&dir.join(SHOTS), &scene)?;
         let own = shots
             .iter()
             .map(|s| {
@@ -354,48 +354,7 @@ pub fn run(inputs: &SetInputs, out: &Path, config: &DiagnoseConfig) -> Result<Se
         .iter()
         .map(|s| samples(&s.target.image, s.target.mask.as_ref()))
         .sum();
-    let mut candidates = Vec::new();
-    let mut accepted: Vec<String> = Vec::new();
-    for round in 1..=config.max_rounds {
-        let residuals = model.residuals(inputs);
-        let k0 = model.dim(inputs);
-        let mut tried: Vec<(Candidate, SetModel)> = Vec::new();
-        for &effect in effects::ALL {
-            if accepted.iter().any(|a| a == effect.name()) {
-                continue;
-            }
-            let Some(ext) = effects::extend(effect, &model.scene) else {
-                continue;
-            };
-            let (start, own) = fits.best_start(&ext, &model.own)?;
-            let fitted = fits.run(&start, &own)?;
-            let k = fitted.dim(inputs);
-            let candidate = Candidate {
-                effect: effect.name().to_string(),
-                evidence: evidence(&residuals, effect),
-                deviation_after: Some(pooled(&fitted.deviations(inputs), inputs)),
-                round,
-                delta_bic: Some(bic(fitted.sad, n, k) - bic(model.sad, n, k0)),
-                gain: Some(1.0 - fitted.sad / model.sad.max(1e-9)),
-                added_params: k.saturating_sub(k0),
-                accepted: false,
-                refit: "warm (set)".into(),
-            };
-            tried.push((candidate, fitted));
-        }
-        tried.sort_by(|a, b| b.0.evidence.total_cmp(&a.0.evidence));
-        let (mut found, models): (Vec<Candidate>, Vec<SetModel>) = tried.into_iter().unzip();
-        let chosen = choose(&found, config);
-        if let Some(i) = chosen {
-            found[i].accepted = true;
-            accepted.push(found[i].effect.clone());
-            model = models.into_iter().nth(i).expect("chosen from these");
-        }
-        candidates.extend(found);
-        if chosen.is_none() {
-            break;
-        }
-    }
+    let (candidates, mut accepted) = rounds(&mut fits, &mut model, n)?;
     let residuals_after = model.residuals(inputs);
     let structured = residuals_after.iter().filter(|r| r.structured()).count();
     let unexplained = 2 * structured > residuals_after.len();
@@ -438,6 +397,60 @@ pub fn run(inputs: &SetInputs, out: &Path, config: &DiagnoseConfig) -> Result<Se
         (&residuals_before, &residuals_after),
     )?;
     Ok(d)
+}
+
+/// The rounds: every effect not yet accepted tried on the set, the
+/// criterion choosing; `model` becomes the accepted one. The candidates
+/// of every round and the effects accepted.
+fn rounds(
+    fits: &mut SetRefits,
+    model: &mut SetModel,
+    n: f64,
+) -> Result<(Vec<Candidate>, Vec<String>)> {
+    let inputs = fits.inputs;
+    let mut candidates = Vec::new();
+    let mut accepted: Vec<String> = Vec::new();
+    for round in 1..=fits.config.max_rounds {
+        let residuals = model.residuals(inputs);
+        let k0 = model.dim(inputs);
+        let mut tried: Vec<(Candidate, SetModel)> = Vec::new();
+        for &effect in effects::ALL {
+            if accepted.iter().any(|a| a == effect.name()) {
+                continue;
+            }
+            let Some(ext) = effects::extend(effect, &model.scene) else {
+                continue;
+            };
+            let (start, own) = fits.best_start(&ext, &model.own)?;
+            let fitted = fits.run(&start, &own)?;
+            let k = fitted.dim(inputs);
+            let candidate = Candidate {
+                effect: effect.name().to_string(),
+                evidence: evidence(&residuals, effect),
+                deviation_after: Some(pooled(&fitted.deviations(inputs), inputs)),
+                round,
+                delta_bic: Some(bic(fitted.sad, n, k) - bic(model.sad, n, k0)),
+                gain: Some(1.0 - fitted.sad / model.sad.max(1e-9)),
+                added_params: k.saturating_sub(k0),
+                accepted: false,
+                refit: "warm (set)".into(),
+            };
+            tried.push((candidate, fitted));
+        }
+        tried.sort_by(|a, b| b.0.evidence.total_cmp(&a.0.evidence));
+        let (mut found, models): (Vec<Candidate>, Vec<SetModel>) = tried.into_iter().unzip();
+        let chosen = choose(&found, fits.config);
+        if let Some(i) = chosen {
+            found[i].accepted = true;
+            accepted.push(found[i].effect.clone());
+            *model = models.into_iter().nth(i).expect("chosen from these");
+        }
+        candidates.extend(found);
+        if chosen.is_none() {
+            break;
+        }
+    }
+    Ok((candidates, accepted))
 }
 
 /// The deviation over every photograph.

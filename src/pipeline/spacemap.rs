@@ -609,6 +609,7 @@ mod tests {
         let f = img(&[90, 60, 190, 15, 20, 35]);
         let c = img(&[10, 200, 0, 255, 0, 7]);
         let target = FitTarget {
+            levels: None,
             image: t.clone(),
             mask: None,
             path: None,
@@ -625,6 +626,7 @@ mod tests {
         let f = img(&[60, 200, 128, 30, 200, 3]);
         let ck = img(&[10, 255, 100, 0, 255, 0]);
         let target = FitTarget {
+            levels: None,
             image: t.clone(),
             mask: None,
             path: None,

@@ -20,6 +20,7 @@
 
 mod outcome;
 mod problem;
+pub mod shots;
 mod state;
 
 pub use outcome::{SetOutcome, ShotOutcome, ShotResult};
@@ -28,11 +29,11 @@ pub use problem::counted;
 use super::executor::{Executor, Halt, Offsets};
 use super::{FitConfig, Observer};
 use crate::error::{Error, Result};
+use crate::fit::set::shots::Shot;
 use crate::optimize::{Search, Searcher, Start, StopRule};
 use crate::render::Renderer;
 use crate::rundir::{Mode, RunDir};
 use crate::scene::{Field, ParamSpace, ParamSpec, Scene};
-use crate::shots::Shot;
 use problem::SetProblem;
 use state::SetState;
 use std::path::Path;

@@ -7,13 +7,13 @@
 use super::state::SetState;
 use super::{problem::counted, varying, SetConfig};
 use crate::error::{Error, Result};
+use crate::fit::set::shots::{Shot, ShotsFile, FORMAT};
 use crate::fit::{render_seed, FitResult};
 use crate::metric::{deviation, deviation_levels, Deviation};
 use crate::raster::Image;
 use crate::render::Renderer;
 use crate::rundir::{shot_best_name, RunDir, FITTED_SCENE, RESULT, SHOTS};
 use crate::scene::{ParamSpace, Scene};
-use crate::shots::{Shot, ShotsFile, FORMAT};
 use serde::{Deserialize, Serialize};
 
 /// One photograph's part of result.json.
@@ -61,36 +61,7 @@ pub fn finish(
         .enumerate()
         .map(|(i, s)| state.shot_scene(i, s, &shared, &s.own_space(space)))
         .collect();
-    let mut session = renderer.session(&scenes[0], &varying(space, shots), config.fit.jobs)?;
-    let images = session.render_batch(&scenes, render_seed(config.fit.de.seed, state.generations));
-    let mut outs = Vec::with_capacity(shots.len());
-    for ((shot, scene), img) in shots.iter().zip(scenes).zip(images) {
-        let image = img.map_err(|f| {
-            Error::Run(format!(
-                "{}: the final render of shot {} failed: {f}",
-                renderer.name(),
-                shot.name
-            ))
-        })?;
-        let t = &shot.target;
-        if image.dimensions() != t.image.dimensions() {
-            return Err(Error::Run(format!(
-                "{}: the final render of shot {} has the wrong size",
-                renderer.name(),
-                shot.name
-            )));
-        }
-        let own = shot.own_space(space);
-        outs.push(ShotOutcome {
-            result: ShotResult {
-                name: shot.name.clone(),
-                params: own.json_values(&scene),
-                deviation: deviation(&t.image, &image, t.mask.as_ref()),
-            },
-            scene,
-            image,
-        });
-    }
+    let outs = render_final(scenes, shots, renderer, config, space, state)?;
     let parts: Vec<(Deviation, usize)> = outs
         .iter()
         .zip(shots)
@@ -126,6 +97,48 @@ pub fn finish(
         write(d, &outcome, shots)?;
     }
     Ok(outcome)
+}
+
+/// Every photograph rendered once at its final values, and scored.
+fn render_final(
+    scenes: Vec<Scene>,
+    shots: &[Shot],
+    renderer: &dyn Renderer,
+    config: &SetConfig,
+    space: &ParamSpace,
+    state: &SetState,
+) -> Result<Vec<ShotOutcome>> {
+    let mut session = renderer.session(&scenes[0], &varying(space, shots), config.fit.jobs)?;
+    let images = session.render_batch(&scenes, render_seed(config.fit.de.seed, state.generations));
+    let mut outs = Vec::with_capacity(shots.len());
+    for ((shot, scene), img) in shots.iter().zip(scenes).zip(images) {
+        let image = img.map_err(|f| {
+            Error::Run(format!(
+                "{}: the final render of shot {} failed: {f}",
+                renderer.name(),
+                shot.name
+            ))
+        })?;
+        let t = &shot.target;
+        if image.dimensions() != t.image.dimensions() {
+            return Err(Error::Run(format!(
+                "{}: the final render of shot {} has the wrong size",
+                renderer.name(),
+                shot.name
+            )));
+        }
+        let own = shot.own_space(space);
+        outs.push(ShotOutcome {
+            result: ShotResult {
+                name: shot.name.clone(),
+                params: own.json_values(&scene),
+                deviation: deviation(&t.image, &image, t.mask.as_ref()),
+            },
+            scene,
+            image,
+        });
+    }
+    Ok(outs)
 }
 
 /// The deviation from the photographs' unrounded levels, over the set,

@@ -6,10 +6,10 @@
 use super::SetConfig;
 use crate::error::{Error, Result};
 use crate::fit::identity::RunIdentity;
+use crate::fit::set::shots::Shot;
 use crate::render::Renderer;
 use crate::rundir::{RunDir, SET_STATE};
 use crate::scene::{ParamSpace, Scene};
-use crate::shots::Shot;
 use serde::{Deserialize, Serialize};
 
 const FORMAT: &str = "scenefit-set-state/1";
