@@ -37,8 +37,10 @@ pub struct FitInputs {
 }
 
 impl FitInputs {
-    /// The photograph and mask, checked against the scene's image size.
-    pub fn target(&self, scene: &Scene, quiet: bool) -> Result<FitTarget> {
+    /// The photograph and mask, checked against the scene's image size,
+    /// and a line saying how many saturated pixels were left out (said once
+    /// the run has succeeded: a refused run says only why).
+    pub fn target(&self, scene: &Scene) -> Result<(FitTarget, Option<String>)> {
         let Some(target) = &self.target else {
             return Err(Error::Usage(
                 "--shots: this command fits one photograph; give --target".into(),
@@ -46,11 +48,14 @@ impl FitInputs {
         };
         let size = (scene.image.width, scene.image.height);
         let mask = self.mask.as_deref().map(|m| (m, "--mask"));
-        let (target, note) = FitTarget::from_photo(target, "--target", mask, self.encoding, size)?;
-        if let (Some(n), false) = (note, quiet) {
-            eprintln!("{n}");
-        }
-        Ok(target)
+        FitTarget::from_photo(target, "--target", mask, self.encoding, size)
+    }
+}
+
+/// Says `note` on stderr unless `quiet`.
+pub fn tell(note: Option<&str>, quiet: bool) {
+    if let (Some(n), false) = (note, quiet) {
+        eprintln!("{n}");
     }
 }
 
@@ -96,16 +101,18 @@ pub fn run(a: FitArgs) -> Result<()> {
     crate::scene::nuisance::add(&mut scene, &a.nuisance);
     if let Some(shots) = &a.inputs.shots {
         let (shots, notes) = crate::fit::set::shots::load(shots, &scene)?;
-        if let (Some(first), false) = (notes.first(), a.quiet) {
-            eprintln!(
+        run_set(&a, &scene, &shots)?;
+        let note = notes.first().map(|first| {
+            format!(
                 "--shots: saturated pixels left out of the fit in {} of {} photographs (first: {first})",
                 notes.len(),
                 shots.len()
-            );
-        }
-        return run_set(&a, &scene, &shots);
+            )
+        });
+        tell(note.as_deref(), a.quiet);
+        return Ok(());
     }
-    let target = a.inputs.target(&scene, a.quiet)?;
+    let (target, note) = a.inputs.target(&scene)?;
     let renderer = from_spec_with(&a.renderer, &a.render_options.options_in(&a.output))?;
     let mut config = a.search.config(renderer.default_jobs())?;
     let file = a.inputs.scene.display().to_string();
@@ -127,6 +134,7 @@ pub fn run(a: FitArgs) -> Result<()> {
         &mut progress,
     )?;
     progress.finish();
+    tell(note.as_deref(), a.quiet);
     let result = outcome.result;
     if !a.quiet {
         let d = result.deviation;

@@ -100,7 +100,7 @@ pub fn run(a: PipelineArgs) -> Result<()> {
         report::font::use_file(f.clone());
     }
     let scene = load_with(&a.inputs.scene, &a.set)?;
-    let target = a.inputs.target(&scene, a.quiet)?;
+    let (target, note) = a.inputs.target(&scene)?;
     let opts = a.render_options.options_in(&a.output);
     let r1 = renderer(&a.stage1, "--stage1", &opts)?;
     let r2 = renderer(&a.stage2, "--stage2", &opts)?;
@@ -146,6 +146,7 @@ pub fn run(a: PipelineArgs) -> Result<()> {
     if let Some(b) = progress.bar.take() {
         b.finish();
     }
+    super::fit::tell(note.as_deref(), a.quiet);
     let report = if a.no_report {
         None
     } else {
