@@ -5,10 +5,10 @@
 //! that an effect is accepted on the set: an effect shared by every
 //! photograph is weak evidence in one and strong across twenty.
 //!
-//! A refit here is warm: each photograph keeps its fitted own values as
-//! the start of its own block, and the shared block searches the whole box
-//! with the current values one member of its population (this is what the
-//! one-photograph diagnosis gets from its starts and from-scratch refits).
+//! A refit here is warm: it starts from the best of the effect's starts
+//! over the set (each also with its level matched, every free light
+//! intensity scaled, per-shot ones included) and every block of the set
+//! fit searches around the current values.
 
 use super::effects::{self, Effect};
 use super::residual::Residual;
