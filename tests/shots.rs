@@ -150,6 +150,59 @@ fn a_set_fit_recovers_the_shared_material_and_every_photographs_light() {
 }
 
 #[test]
+fn the_joint_step_lowers_what_a_short_block_descent_leaves() {
+    // Block descent on a tiny budget stops well short of the truth; the
+    // joint Levenberg–Marquardt block after it (the last entry of
+    // set_state.json's history) must take most of the rest, moving shared
+    // and per-shot values together.
+    let dir = tempfile::tempdir().unwrap();
+    let c = effects_data::case("none", 1, 1.0, 3, 0.0);
+    let (shots, pos) = write_set(dir.path(), &c.truth, &c.model, 4, 0.0);
+    let model = dir.path().join("model.json").display().to_string();
+    let out = dir.path().join("fit");
+    let o = scenefit(&[
+        "fit",
+        &model,
+        "--shots",
+        &shots,
+        "-o",
+        out.to_str().unwrap(),
+        "--generations",
+        "8",
+        "--rounds",
+        "1",
+        "--quiet",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let state = read_json(&out.join("set_state.json"));
+    let history: Vec<f64> = serde_json::from_value(state["history"].clone()).unwrap();
+    eprintln!("set deviation after each block: {history:?}");
+    let (before, after) = (history[history.len() - 2], history[history.len() - 1]);
+    assert!(
+        after < 0.5 * before,
+        "the joint block took the set from {before:.3} % to {after:.3} % (history {history:?})"
+    );
+    let r = read_json(&out.join("result.json"));
+    assert!((r["deviation"]["average"].as_f64().unwrap() - after).abs() < 1e-6);
+    let worst = r["shots"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .zip(&pos)
+        .map(|(s, want)| {
+            let got: Vec<f64> =
+                serde_json::from_value(s["params"]["lights.key.position"].clone()).unwrap();
+            got.iter()
+                .zip(want)
+                .map(|(a, b)| (a - b) * (a - b))
+                .sum::<f64>()
+                .sqrt()
+        })
+        .fold(0.0, f64::max);
+    assert!(worst < 0.15, "worst light position error {worst:.3}");
+}
+
+#[test]
 fn a_set_fit_gives_the_same_result_for_any_number_of_jobs() {
     let dir = tempfile::tempdir().unwrap();
     let c = effects_data::case("none", 2, 1.0, 5, 1.0);

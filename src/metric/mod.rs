@@ -40,6 +40,18 @@ impl Deviation {
         }
     }
 
+    /// The deviation of per-value residuals (`residuals`' order: r, g, b
+    /// per pixel), in 8-bit levels.
+    pub fn of_residuals(r: &[f32]) -> Deviation {
+        let mut sums = [0f64; 3];
+        for px in r.chunks_exact(3) {
+            for c in 0..3 {
+                sums[c] += f64::from(px[c].abs());
+            }
+        }
+        Deviation::from_level_sums(sums, (r.len() / 3) as u64)
+    }
+
     /// The deviation over several images together, each given with the
     /// number of pixels it counts: every counted pixel weighs the same.
     pub fn pooled(parts: &[(Deviation, usize)]) -> Deviation {

@@ -235,6 +235,27 @@ pub fn adapt_step(step: f64, center: &[f32], perturbed: Option<&[f32]>) -> f64 {
     next.clamp(STEP_MIN, STEP_MAX)
 }
 
+/// The damped step's end point from `x` in the unit cube: coordinates on a
+/// face whose step would leave the cube are held, and the rest clamped.
+/// None when it does not move or the system cannot be solved.
+pub fn bounded_trial(normal: &Normal, lambda: f64, x: &[f64]) -> Option<Vec<f64>> {
+    let mut free = vec![true; x.len()];
+    let mut step = damped_step(normal, lambda, &free)?;
+    let blocked = |x: f64, s: f64| (x <= 0.0 && s < 0.0) || (x >= 1.0 && s > 0.0);
+    if x.iter().zip(&step).any(|(&x, &s)| blocked(x, s)) {
+        for (j, f) in free.iter_mut().enumerate() {
+            *f = !blocked(x[j], step[j]);
+        }
+        step = damped_step(normal, lambda, &free)?;
+    }
+    let trial: Vec<f64> = x
+        .iter()
+        .zip(&step)
+        .map(|(&x, &s)| (x + s).clamp(0.0, 1.0))
+        .collect();
+    (trial != x).then_some(trial)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -37,7 +37,7 @@ mod identifiability;
 mod init;
 mod invariants;
 mod jde;
-mod lm;
+pub mod lm;
 mod operators;
 mod progress;
 mod rand1bin;

@@ -14,10 +14,13 @@
 //!    (`problem`);
 //!
 //! and again 1, 2, … until a round improves the deviation over the whole
-//! set by less than 1 %, or the round budget is spent. Later blocks start
-//! around the current values. The state is saved after every block
+//! set by less than 1 %, or the round budget is spent; then one joint
+//! block moves every coordinate at once by Levenberg–Marquardt (`joint`),
+//! which follows the valleys where shared and per-shot values trade.
+//! Later blocks start around the current values. The state is saved after every block
 //! (`state`), so `--resume` continues from the last finished block.
 
+mod joint;
 mod outcome;
 mod problem;
 pub mod shots;
@@ -125,11 +128,13 @@ pub fn run_in(
             Block::Shared => shared_block(
                 &mut state, shots, renderer, config, &space, observer, dir, &mut clear,
             )?,
+            Block::Joint => joint::run(&mut state, shots, renderer, config, &space, &mut clear)?,
         };
         state.history.push(total);
         state.blocks_done += 1;
         if block == Block::Own && converged(&state.history) {
-            state.blocks_done = plan.len();
+            // Straight to the joint block, if there is one.
+            state.blocks_done = plan.len() - usize::from(plan.last() == Some(&Block::Joint));
         }
         state.seconds = before + started.elapsed().as_secs_f64();
         if let Some(d) = dir {
@@ -144,10 +149,13 @@ pub fn run_in(
 enum Block {
     Own,
     Shared,
+    /// Every coordinate at once, by Levenberg–Marquardt (`joint`).
+    Joint,
 }
 
 /// The blocks in order: own, shared, own, shared, own, … (`rounds` shared
-/// blocks), leaving out a kind of block that has no parameters.
+/// blocks), then the joint block; a set with only one kind of parameter
+/// has only that block.
 fn plan(space: &ParamSpace, shots: &[Shot], rounds: usize, warm: bool) -> Vec<Block> {
     let has_own = shots.iter().any(|s| !s.own_space(space).is_empty());
     let has_shared = !space.shared().is_empty();
@@ -157,6 +165,7 @@ fn plan(space: &ParamSpace, shots: &[Shot], rounds: usize, warm: bool) -> Vec<Bl
             for _ in 0..rounds.max(1) {
                 v.extend([Block::Shared, Block::Own]);
             }
+            v.push(Block::Joint);
             v
         }
         (true, false) => vec![Block::Own],
