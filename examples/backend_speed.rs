@@ -68,6 +68,7 @@ fn main() {
             levels: None,
             mask: None,
             path: None,
+            encoding: None,
         },
         renderer.as_ref(),
         &config,

@@ -83,6 +83,7 @@ fn main() {
             levels: None,
             mask: Some(mask.clone()),
             path: Some(dir.join("target.png")),
+            encoding: None,
         };
         let fit_dir = dir.join("fit");
         let r = fit::run(

@@ -78,6 +78,7 @@ fn diagnosis_of_a_photograph_brings_the_light_closer() {
         levels: None,
         mask: Some(mask.clone()),
         path: None,
+        encoding: None,
     };
     let phong = from_spec("phong").unwrap();
     let r = fit::run(&scene, &t, phong.as_ref(), &config, dir.path(), &mut ())
@@ -149,6 +150,7 @@ fn light_direction_of_a_photograph_within_four_degrees() {
         levels: None,
         mask: Some(mask),
         path: None,
+        encoding: None,
     };
     let r = fit::run(
         &scene,

@@ -72,6 +72,7 @@ fn recovers_hidden_truth_for_the_papers_six_colours() {
             levels: None,
             mask: None,
             path: None,
+            encoding: None,
         };
         let r = fit::run(&base, &target, phong.as_ref(), &config, dir.path(), &mut ())
             .unwrap()

@@ -193,6 +193,33 @@ fn linear_sixteen_bit_png_and_exr_read_as_the_srgb_image() {
         avg(&r),
         avg(&r2)
     );
+    // The encoding is recorded, and `diagnose` reads the target as the fit
+    // did: its starting deviation is the fit's, not the sRGB misreading's.
+    assert_eq!(r2["target_encoding"], "linear", "{r2}");
+    assert_eq!(r["target_encoding"], "linear", "OpenEXR: {r}");
+    let o = scenefit(
+        d.path(),
+        &[
+            "diagnose",
+            "run2",
+            "-o",
+            "diag",
+            "--generations",
+            "2",
+            "--population",
+            "8",
+            "--max-effects",
+            "1",
+        ],
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let dj = json(&d.path().join("diag/diagnosis.json"));
+    let before = dj["deviation_before"]["average"].as_f64().unwrap();
+    assert!(
+        (before - avg(&r2)).abs() < 1e-9,
+        "diagnose started at {before}, the fit ended at {}",
+        avg(&r2)
+    );
 }
 
 #[test]

@@ -102,6 +102,7 @@ pub fn run(a: DemoArgs) -> Result<()> {
             levels: None,
             mask: None,
             path: Some(run_dir.file(TARGET)),
+            encoding: None,
         };
         let mut progress = Progress::new(a.quiet);
         let outcome = fit::run_in(

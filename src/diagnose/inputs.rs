@@ -5,6 +5,7 @@
 use crate::error::Result;
 use crate::fit::{FitResult, FitTarget};
 use crate::metric::Mask;
+use crate::raster::Encoding;
 use crate::raster::Image;
 use crate::rundir::{RunDir, FITTED_SCENE, MASK};
 use crate::scene::Scene;
@@ -23,9 +24,12 @@ impl Inputs {
     /// when present.
     pub fn from_fit_dir(dir: &Path, target: Option<&Path>, mask: Option<&Path>) -> Result<Inputs> {
         let scene = crate::scene::load(&dir.join(FITTED_SCENE))?;
-        let (target_path, what) = match target {
-            Some(t) => (t.to_path_buf(), "--target"),
-            None => (fit_target(dir)?, "the fit's target"),
+        let (target_path, what, encoding) = match target {
+            Some(t) => (t.to_path_buf(), "--target", None),
+            None => {
+                let (path, encoding) = fit_target(dir)?;
+                (path, "the fit's target", encoding)
+            }
         };
         let size = (scene.image.width, scene.image.height);
         let default_mask = dir.join(MASK);
@@ -33,7 +37,7 @@ impl Inputs {
             .map(Path::to_path_buf)
             .or_else(|| default_mask.exists().then_some(default_mask));
         let mask = mask_path.as_deref().map(|m| (m, "--mask"));
-        let (target, note) = FitTarget::from_photo(&target_path, what, mask, None, size)?;
+        let (target, note) = FitTarget::from_photo(&target_path, what, mask, encoding, size)?;
         if let Some(n) = note {
             // Diagnose has no --quiet and prints its own summary: said once.
             eprintln!("{n}");
@@ -46,9 +50,13 @@ impl Inputs {
     }
 }
 
-/// The target result.json names, found by the run directory's one rule.
-fn fit_target(dir: &Path) -> Result<PathBuf> {
+/// The target result.json names, found by the run directory's one rule,
+/// and the encoding the fit read it in.
+fn fit_target(dir: &Path) -> Result<(PathBuf, Option<Encoding>)> {
     let run = RunDir::existing(dir)?;
     let result = FitResult::load(&run)?;
-    run.find_target(result.target.as_deref())
+    Ok((
+        run.find_target(result.target.as_deref())?,
+        result.target_encoding,
+    ))
 }

@@ -105,6 +105,7 @@ impl<'a> Refits<'a> {
             levels: None,
             mask: inputs.mask.clone(),
             path: None,
+            encoding: None,
         };
         Refits {
             renderer,

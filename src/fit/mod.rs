@@ -345,6 +345,7 @@ fn finish(
         wall_seconds: state.elapsed_before,
         stop_reason: reason.to_string(),
         target: target.path.as_ref().map(|p| p.display().to_string()),
+        target_encoding: target.encoding,
         failed_renders,
         identifiability: search
             .identifiability()

@@ -28,6 +28,10 @@ pub struct FitResult {
     pub stop_reason: String,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub target: Option<String>,
+    /// How the target's values were read (`srgb` or `linear`), so that
+    /// `diagnose` and `report` read it the same way.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub target_encoding: Option<crate::raster::Encoding>,
     #[serde(default)]
     pub failed_renders: usize,
     /// Standard errors and correlations from a local search's final

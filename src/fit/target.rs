@@ -16,6 +16,10 @@ pub struct FitTarget {
     pub mask: Option<Mask>,
     /// For result.json.
     pub path: Option<PathBuf>,
+    /// How the photograph's values were read (for result.json, so that
+    /// `diagnose` and `report` read it the same way); None for an image
+    /// made in memory.
+    pub encoding: Option<Encoding>,
 }
 
 impl FitTarget {
@@ -59,6 +63,7 @@ impl FitTarget {
             image: p.image,
             mask,
             path: Some(photo.to_path_buf()),
+            encoding: Some(p.encoding),
         };
         Ok((target, note))
     }

@@ -393,6 +393,7 @@ fn surrogate_step(
         levels: None,
         mask: target.mask.clone(),
         path: None,
+        encoding: None,
     };
     // The trust region as bounds: x_k ± radius × original span, clamped
     // to the original bounds (a hue box across red keeps the full circle).
@@ -562,6 +563,7 @@ fn finish(
         wall_seconds: state.seconds,
         stop_reason: state.stop_reason.clone().unwrap_or_default(),
         target: target.path.as_ref().map(|p| p.display().to_string()),
+        target_encoding: target.encoding,
         failed_renders: 0,
         identifiability: None,
         deviation_precise: None,
@@ -613,6 +615,7 @@ mod tests {
             image: t.clone(),
             mask: None,
             path: None,
+            encoding: None,
         };
         let s = surrogate_deviation(&target, &c, &f, &c);
         assert_eq!(s, deviation(&t, &f, None));
@@ -630,6 +633,7 @@ mod tests {
             image: t.clone(),
             mask: None,
             path: None,
+            encoding: None,
         };
         let corrected = corrected_target(&t, &f, &ck);
         let gaps: Vec<f64> = [[0u8; 6], [255; 6], [7, 99, 200, 13, 0, 255]]

@@ -182,6 +182,7 @@ mod tests {
             wall_seconds: 1.1,
             stop_reason: String::new(),
             target: None,
+            target_encoding: None,
             failed_renders: 0,
             identifiability: None,
             shots: None,

@@ -96,19 +96,15 @@ fn load(dir: &Path, options: &ReportOptions) -> Result<Run> {
             .map_err(|e| e.to_string()),
     };
     let best = &stages[0].best;
+    // Read as the fit read it: a linear PNG is not sRGB.
+    let encoding = match options.target {
+        Some(_) => None,
+        None => stages[0].result.target_encoding,
+    };
     let target = target_path.and_then(|p| {
-        let img = image_io::read_image(&p, "target").map_err(|e| e.to_string())?;
-        if img.dimensions() != best.dimensions() {
-            return Err(format!(
-                "{} is {}x{}, the renders {}x{}",
-                p.display(),
-                img.width(),
-                img.height(),
-                best.width(),
-                best.height()
-            ));
-        }
-        Ok(img)
+        image_io::read_photo(&p, "target", best.dimensions(), encoding)
+            .map(|photo| photo.image)
+            .map_err(|e| e.to_string())
     });
     if let (Some(p), Err(m)) = (&options.target, &target) {
         return Err(Error::Usage(format!("--target {}: {m}", p.display())));

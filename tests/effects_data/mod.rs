@@ -140,6 +140,7 @@ pub fn fit_case(c: &Case, dir: &Path, seed: u64) -> fit::FitResult {
         levels: None,
         mask: None,
         path: Some(dir.join("target.png")),
+        encoding: None,
     };
     scenefit::raster::io::write_image(&c.target, &dir.join("target.png")).unwrap();
     let config = FitConfig {

@@ -83,6 +83,7 @@ pub fn finish(
             state.shared_blocks
         ),
         target: None,
+        target_encoding: None,
         failed_renders: state.failed_renders,
         identifiability: None,
         shots: Some(outs.iter().map(|o| o.result.clone()).collect()),
