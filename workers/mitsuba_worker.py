@@ -955,8 +955,8 @@ class MitsubaBackend:
         value outside what a recording sees: recording fails). Renders
         are the same to the bit as traced ones (checked per parameter kind
         when this was written). SCENEFIT_MITSUBA_FREEZE=0 turns it off."""
-        if not FREEZE or self.mi.variant().startswith("scalar"):
-            return None
+        if not FREEZE or self.mi.variant().startswith("scalar") or not hasattr(self.dr, "freeze"):
+            return None  # older Dr.Jit has no dr.freeze: trace every time
         if plan["camera"]["type"] != "perspective":
             return None
         mi = self.mi
