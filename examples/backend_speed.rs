@@ -14,6 +14,10 @@
 //! optimizer, the metric, checkpoints, writing requests, reading images). CPU per render splits the
 //! CPU time into scenefit's own and its renderer processes' (workers are
 //! counted once they exit, at the end of the fit).
+//!
+//! A second line is the row of the table in docs/benchmarks-backends.md,
+//! with the 1-minute load average read before the fit;
+//! scripts/bench-backends.sh runs the three backends and prints the table.
 
 use scenefit::exec::stats;
 use scenefit::fit::{self, FitConfig, FitTarget};
@@ -45,6 +49,7 @@ fn main() {
     if args.iter().any(|a| a == "--direct") {
         scene.render.indirect = false;
     }
+    let load = load_average();
     let target = render_one(renderer.as_ref(), &scene, 0).unwrap_or_else(|e| fail(&e.to_string()));
     let dir = tempfile::tempdir().unwrap_or_else(|e| fail(&e.to_string()));
     let config = FitConfig {
@@ -102,6 +107,35 @@ fn main() {
         1e3 * children / result.evaluations as f64,
         100.0 * own / (own + children).max(1e-12)
     );
+    let mode = format!(
+        "{jobs} {}, {}",
+        if renderer_name == "povray" {
+            "processes"
+        } else {
+            "workers"
+        },
+        if scene.render.indirect {
+            "indirect"
+        } else {
+            "direct"
+        }
+    );
+    println!(
+        "| {renderer_name} | {mode} | {load} | {:.1} | {:.1} ms | {:.2} ms | {:.1} % | {:.1} % |",
+        result.evaluations as f64 / wall,
+        1e3 * children / result.evaluations as f64,
+        1e3 * own / result.evaluations as f64,
+        100.0 * outside,
+        100.0 * idle_share
+    );
+}
+
+/// The 1-minute load average (/proc/loadavg), or "?".
+fn load_average() -> String {
+    std::fs::read_to_string("/proc/loadavg")
+        .ok()
+        .and_then(|s| s.split_whitespace().next().map(str::to_string))
+        .unwrap_or_else(|| "?".into())
 }
 
 /// CPU seconds of this process and of its waited-for children

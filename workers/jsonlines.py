@@ -7,7 +7,7 @@ blender_scripts/worker.py); a worker supplies only its render function:
     channel = jsonlines.Channel()          # before anything prints to stdout
     ... set the renderer up ...
     channel.ready("myrenderer 1.0")
-    channel.serve(render)                  # render(scene, output, seed)
+    channel.serve(render)                  # render(scene, output, seed, raw)
 
 The protocol: stdout carries protocol lines only. The first is
 ``{"ready": true, "renderer": "..."}`` (or ``{"ready": false, "error": "..."}``
@@ -17,6 +17,14 @@ optional, default 0; other keys ignored) gets exactly one answer
 ``{"id": 17, "ok": true}`` or ``{"id": 17, "ok": false, "error": "..."}``. A
 malformed line is answered ok:false (id null when none could be read) and the
 worker keeps serving. EOF on stdin ends ``serve``.
+
+Raw pixels (the protocol's optional extension): a request with
+``"pixels": "raw"`` lets the worker write, instead of an image file, the
+image's 8-bit sRGB RGB bytes (rows top to bottom, no header: exactly
+width*height*3 bytes) at ``output``, and answer ``{"id": 17, "ok": true,
+"pixels": "raw"}``; no image is encoded here nor decoded by scenefit. A
+render function returns "raw" when it did so (``write_raw``), anything else
+when it wrote an image file.
 
 Whatever the renderer or Python print goes to stderr: ``Channel()`` keeps a
 private duplicate of fd 1 for the protocol and points fd 1 at fd 2 (or at
@@ -63,8 +71,9 @@ class Channel:
         self.send({"ready": False, "error": error})
 
     def serve(self, render, on_error=None):
-        """Answers requests until EOF. ``render(scene, output, seed)`` draws
-        one scene into the file ``output``; it raises RequestError for a bad
+        """Answers requests until EOF. ``render(scene, output, seed, raw)``
+        draws one scene into the file ``output``, as raw pixels when ``raw``
+        is true and it can (then it returns "raw"); it raises RequestError for a bad
         scene, anything else for a failure (then ``on_error()`` runs, e.g. to
         drop a half-updated scene, and the traceback goes to stderr)."""
         stdin = sys.stdin.buffer
@@ -79,9 +88,11 @@ class Channel:
             try:
                 req = parse(line)
                 rid = req.get("id")
-                scene, output, seed = fields(req)
-                render(scene, output, seed)
-                self.send({"id": rid, "ok": True})
+                scene, output, seed, raw = fields(req)
+                answer = {"id": rid, "ok": True}
+                if render(scene, output, seed, raw) == "raw":
+                    answer["pixels"] = "raw"
+                self.send(answer)
             except RequestError as e:
                 self.send({"id": rid, "ok": False, "error": str(e)})
             except Exception as e:
@@ -108,7 +119,8 @@ def parse(line):
 
 
 def fields(req):
-    """The request's scene, output path and seed (a non-negative integer)."""
+    """The request's scene, output path, seed (a non-negative integer) and
+    whether raw pixels are welcome."""
     if "scene" not in req:
         raise RequestError("request: missing \"scene\"")
     output = req.get("output")
@@ -119,4 +131,22 @@ def fields(req):
         seed = 0
     if not isinstance(seed, int) or isinstance(seed, bool) or seed < 0:
         raise RequestError("request: \"seed\" must be a non-negative integer, got %r" % (seed,))
-    return req["scene"], output, seed
+    return req["scene"], output, seed, req.get("pixels") == "raw"
+
+
+def write_raw(output, data):
+    """Writes raw pixel bytes to ``output`` through a temporary name beside
+    it (a half-written file is never read); returns "raw" for ``serve``."""
+    out = os.path.abspath(output)
+    tmp = os.path.join(os.path.dirname(out), ".%s.tmp%d" % (os.path.basename(out), os.getpid()))
+    try:
+        with open(tmp, "wb") as f:
+            f.write(data)
+        os.replace(tmp, out)
+    except OSError as e:
+        try:
+            os.unlink(tmp)
+        except OSError:
+            pass
+        raise RequestError("cannot write %s: %s" % (output, e))
+    return "raw"

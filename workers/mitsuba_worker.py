@@ -103,7 +103,15 @@ materials (d = diffuse, c = color, ks = specular, n = shininess, kr = reflection
   Principled BSDF); the lobes are mixed energy-conserving (blend), not added.
 Output: the film's linear RGB is converted with
 ``mi.Bitmap(img).convert(RGB, UInt8, srgb_gamma=True)`` (standard sRGB curve, clamped)
-and written as PNG to a temporary name next to `output`, then os.replace'd.
+and written to a temporary name next to `output`, then os.replace'd: as raw
+bytes when the request asks ``"pixels": "raw"`` (answered with ``"pixels": "raw"``),
+else as PNG.
+
+Speed, 2: in JIT (llvm) variants with a perspective camera, ``mi.render`` runs
+through ``dr.freeze`` (``MitsubaBackend.freezable``): the kernels are recorded
+once per scene structure and replayed with new values, instead of being traced
+through Python for every request. SCENEFIT_MITSUBA_FREEZE=0 turns this off;
+SCENEFIT_WORKER_DEBUG=1 prints each request's phase times to stderr.
 """
 
 import argparse
@@ -121,6 +129,10 @@ MAX_DEPTH_INDIRECT = 9
 # render.indirect false: Mitsuba's `direct` integrator (default) or, with
 # SCENEFIT_MITSUBA_DIRECT=path in the environment, `path` with max_depth 2.
 DIRECT_WITH_PATH = os.environ.get("SCENEFIT_MITSUBA_DIRECT", "") == "path"
+# Frozen renders (MitsubaBackend.freezable) unless SCENEFIT_MITSUBA_FREEZE=0.
+FREEZE = os.environ.get("SCENEFIT_MITSUBA_FREEZE", "1") != "0"
+# Per-request phase times on stderr (PhaseTimer).
+DEBUG = bool(os.environ.get("SCENEFIT_WORKER_DEBUG"))
 
 
 class SceneError(jsonlines.RequestError):
@@ -663,6 +675,7 @@ class MitsubaBackend:
         self.values = {}         # param key -> last value written (plain tuples/floats)
         self.unit_cubes = {}     # param key of vertex_positions -> unit cube positions (list)
         self.rebuilds = 0
+        self.frozen = None       # the loaded scene's frozen render, if any (draw)
 
     # --- dict construction
     def rgb(self, c):
@@ -873,11 +886,14 @@ class MitsubaBackend:
                 key = "O%d.vertex_positions" % i
                 self.unit_cubes[key] = [float(x) for x in self.params[key]]
         self.write_values(self.plan_values(plan), force=True)
+        self.frozen = self.freezable(plan)
         self.signature = signature
         self.rebuilds += 1
 
-    def render(self, scene_json, output, seed):
+    def render(self, scene_json, output, seed, raw=False):
+        """Draws one request; returns "raw" when it wrote raw pixels."""
         mi = self.mi
+        timer = PhaseTimer()
         signature, plan = make_plan(scene_json)
         if self.mi.variant().startswith("scalar"):
             # scalar variants hold the own plug-ins' values as plain floats,
@@ -886,10 +902,20 @@ class MitsubaBackend:
                          repr([o["material"] for o in plan["objects"] if o["material"]["kind"][0] == "phong"]))
         if signature != self.signature or self.scene is None:
             self.build(plan, signature)
+            timer.lap("build")
         else:
             self.write_values(self.plan_values(plan), force=False)
-        img = mi.render(self.scene, self.params, seed=seed, spp=plan["spp"])
+            timer.lap("update")
+        img = self.draw(seed, plan["spp"])
+        timer.lap("render")
         bmp = mi.Bitmap(img).convert(mi.Bitmap.PixelFormat.RGB, mi.Struct.Type.UInt8, srgb_gamma=True)
+        timer.lap("srgb")
+        data = raw_bytes(bmp) if raw else None
+        if data is not None:
+            wrote = jsonlines.write_raw(output, data)
+            timer.lap("raw write")
+            timer.report()
+            return wrote
         out_dir = os.path.dirname(os.path.abspath(output))
         tmp = os.path.join(out_dir, ".%s.tmp%d.png" % (os.path.basename(output), os.getpid()))
         try:
@@ -902,6 +928,87 @@ class MitsubaBackend:
                 pass
             # the scene itself is fine: no rebuild needed
             raise SceneError("cannot write %s: %s" % (output, str(e).strip()))
+        timer.lap("png write")
+        timer.report()
+        return None
+
+    def draw(self, seed, spp):
+        """The film of the loaded scene: replayed from a frozen recording
+        when there is one (see ``freezable``), else traced anew."""
+        mi = self.mi
+        if self.frozen is not None:
+            try:
+                return self.frozen(self.scene, mi.UInt32(seed), spp)
+            except RuntimeError as e:
+                # this structure cannot be recorded: trace it every time
+                sys.stderr.write("mitsuba_worker: frozen render unavailable, tracing (%s)\n"
+                                 % str(e).strip().splitlines()[0])
+                self.frozen = None
+        return mi.render(self.scene, self.params, seed=seed, spp=spp)
+
+    def freezable(self, plan):
+        """A frozen render (``dr.freeze``) for this scene, or None. Tracing
+        mi.render through Python (the scenefit_phong BSDF included) cost ~6 ms
+        of a 16 ms render at 128x96; a recording replays the kernels with
+        the new parameter values without tracing. Only JIT variants record;
+        only perspective cameras are used (an orthographic camera keeps a
+        value outside what a recording sees: recording fails). Renders
+        are the same to the bit as traced ones (checked per parameter kind
+        when this was written). SCENEFIT_MITSUBA_FREEZE=0 turns it off."""
+        if not FREEZE or self.mi.variant().startswith("scalar") or not hasattr(self.dr, "freeze"):
+            return None  # older Dr.Jit has no dr.freeze: trace every time
+        if plan["camera"]["type"] != "perspective":
+            return None
+        mi = self.mi
+
+        def render(scene, seed, spp):
+            return mi.render(scene, seed=seed, spp=spp)
+
+        # one recording per spp value is expected; a new structure is a new
+        # scene and a new frozen function, so the old recordings go with it
+        return self.dr.freeze(render, limit=4, warn_after=100)
+
+
+class PhaseTimer:
+    """Per-phase wall times of one request, printed to stderr when
+    SCENEFIT_WORKER_DEBUG is set (the profile of docs/benchmarks-backends.md)."""
+
+    def __init__(self):
+        self.last = time.perf_counter()
+        self.start = self.last
+        self.cpu = time.process_time()
+        self.phases = []
+
+    def lap(self, name):
+        if DEBUG:
+            now = time.perf_counter()
+            self.phases.append((name, now - self.last))
+            self.last = now
+
+    def report(self):
+        if DEBUG:
+            parts = " ".join("%s %.2f" % (n, 1000 * t) for n, t in self.phases)
+            sys.stderr.write("mitsuba_worker: ms %s; total %.2f, cpu %.2f\n"
+                             % (parts, 1000 * (time.perf_counter() - self.start),
+                                1000 * (time.process_time() - self.cpu)))
+
+
+def raw_bytes(bmp):
+    """The 8-bit pixels of a Bitmap as bytes (rows top to bottom, as its
+    PNG), or None when this Mitsuba does not expose them; ctypes reads the
+    buffer Mitsuba describes by its array interface, without numpy."""
+    import ctypes
+    try:
+        ai = bmp.__array_interface__
+        size = bmp.width() * bmp.height() * bmp.channel_count()
+        typestr = ai.get("typestr")
+        if isinstance(typestr, bytes):
+            typestr = typestr.decode("ascii", "replace")
+        if typestr not in ("<u1", "|u1") or ai.get("strides") is not None:
+            return None
+        return ctypes.string_at(ai["data"][0], size)
+    except (AttributeError, TypeError, KeyError):
+        return None
 
 
 # ---------------------------------------------------------------- main loop
@@ -947,14 +1054,9 @@ def main(argv=None):
 
     backend = MitsubaBackend(mi, dr)
     channel.ready("mitsuba %s %s" % (mi.__version__, variant))
-    debug = bool(os.environ.get("SCENEFIT_WORKER_DEBUG"))
 
-    def render(scene, output, seed):
-        t0 = time.perf_counter()
-        backend.render(scene, output, seed & 0xFFFFFFFF)
-        if debug:
-            sys.stderr.write("mitsuba_worker: render in %.1f ms (rebuilds %d)\n"
-                             % (1000 * (time.perf_counter() - t0), backend.rebuilds))
+    def render(scene, output, seed, raw):
+        return backend.render(scene, output, seed & 0xFFFFFFFF, raw)
 
     def forget_scene():
         # the loaded scene may be half-updated: rebuild next time

@@ -9,7 +9,7 @@
 use super::cancel;
 use super::output;
 use super::process::CommandSpec;
-use super::worker::{RequestError, Worker};
+use super::worker::{RequestError, Worker, Written};
 use super::ExecConfig;
 use super::{RenderFailure, RenderResult};
 use std::collections::VecDeque;
@@ -268,8 +268,11 @@ impl Slot {
             };
             output::remove(&job.output);
             match w.request(&job.line, job.id, cfg.render_timeout).await {
-                Ok(()) => {
-                    let img = output::read(&job.output, job.width, job.height);
+                Ok(written) => {
+                    let img = match written {
+                        Written::Image => output::read(&job.output, job.width, job.height),
+                        Written::Raw => output::read_raw(&job.output, job.width, job.height),
+                    };
                     output::remove(&job.output);
                     match img {
                         Ok(img) => return Ok(img),

@@ -6,6 +6,8 @@
 //! not treated as errors. What breaks the protocol fails the request at
 //! once and the worker is replaced: a line longer than `MAX_LINE`, an
 //! answer to another id, a line that would be an answer but is not JSON.
+//! An answer `"pixels": "raw"` says the output file holds raw pixels
+//! rather than an image file (the protocol's optional extension).
 
 use super::launcher::{Launched, Launcher};
 use super::process::{CommandSpec, Group};
@@ -44,6 +46,15 @@ pub enum RequestError {
     Answered(String),
     /// The worker died, hung or broke the protocol; it must be replaced.
     Dead(String),
+}
+
+/// What a worker that answered ok wrote at the request's output path.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Written {
+    /// An image file (PNG, BMP, ...): every worker may answer this way.
+    Image,
+    /// Raw 8-bit sRGB RGB pixels, no header (answer `"pixels": "raw"`).
+    Raw,
 }
 
 /// What a line on the worker's stdout is.
@@ -206,7 +217,7 @@ impl Worker {
         line: &str,
         id: u64,
         timeout: Duration,
-    ) -> Result<(), RequestError> {
+    ) -> Result<Written, RequestError> {
         self.mark = self.tail.mark();
         let started = super::stats::begin();
         let result = self.exchange(line, id, timeout).await;
@@ -219,7 +230,7 @@ impl Worker {
         line: &str,
         id: u64,
         timeout: Duration,
-    ) -> Result<(), RequestError> {
+    ) -> Result<Written, RequestError> {
         let deadline = Instant::now() + timeout;
         self.send(line, deadline, timeout).await?;
         loop {
@@ -288,7 +299,7 @@ impl Worker {
 
     /// What one stdout line means for request `id`: None when it is not
     /// the answer (kept in the log tail), else the request's outcome.
-    fn answer(&mut self, line: &str, id: u64) -> Option<Result<(), RequestError>> {
+    fn answer(&mut self, line: &str, id: u64) -> Option<Result<Written, RequestError>> {
         let Line::Json(m) = classify(line) else {
             if line.starts_with('{') && line.contains("\"id\"") {
                 // meant as an answer, but unreadable: waiting on would
@@ -323,7 +334,8 @@ impl Worker {
         }
         self.renders += 1;
         if m.get("ok") == Some(&Value::Bool(true)) && ours {
-            return Some(Ok(()));
+            let raw = m.get("pixels").and_then(Value::as_str) == Some("raw");
+            return Some(Ok(if raw { Written::Raw } else { Written::Image }));
         }
         let why = m
             .get("error")

@@ -163,10 +163,13 @@ impl ExternalSession {
     }
 }
 
-/// The request line of the plug-in protocol for one render.
+/// The request line of the plug-in protocol for one render. It offers the
+/// raw-pixel extension (`"pixels": "raw"`, docs/plugins.md): a worker that
+/// knows it skips image encoding and decoding and says so in its answer;
+/// one that does not ignores the key and writes an image file.
 pub fn request_line(id: u64, scene: &Scene, output: &Path, seed: u64) -> String {
     let scene = plain_scene(scene);
-    serde_json::json!({"id": id, "scene": scene, "output": output.to_string_lossy(), "seed": seed})
+    serde_json::json!({"id": id, "scene": scene, "output": output.to_string_lossy(), "seed": seed, "pixels": "raw"})
         .to_string()
 }
 
