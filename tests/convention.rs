@@ -4,7 +4,9 @@
 //! draws the built-in tracer's highlight within 3 % on the highlight's
 //! pixels and within 1 % over the image, and a scene as `scenefit diagnose`
 //! leaves it (with `falloff_power` and `specular2`) re-renders in Blender,
-//! Mitsuba and POV-Ray within 1 % of the built-in tracer.
+//! Mitsuba and POV-Ray within 1 % of the built-in tracer. Blender's lobe
+//! with two lights (its colour follows the first) is measured and held to
+//! the same 3 % and 1 %.
 //! Renderers run for real; a missing one skips its test unless CI=true.
 
 #[path = "backends_common/mod.rs"]
@@ -243,4 +245,35 @@ fn the_fresnel_cases_depend_on_fresnel() {
         eprintln!("{case:?} without fresnel: highlight {:.2} %", a.highlight);
         assert!(a.highlight > 3.0, "{case:?}: {:.2} %", a.highlight);
     }
+}
+
+/// Blender's lobe colour is computed for the scene's first light
+/// (docs/renderers.md): a second light sees that light's colour. Two
+/// lights on a glossy ball, each making its own highlight, direct light:
+/// the second highlight is approximate; this measures how far and holds
+/// it to the convention's 3 % on the highlights and 1 % over the image.
+fn two_lights(specular: bool) -> Scene {
+    let mut scene = glossy((0.5, 100.0, None), specular);
+    let mut fill = scene.lights[0].clone();
+    fill.name = "fill".into();
+    fill.position = Some([-2.5, 1.5, 1.5]);
+    scene.lights.push(fill);
+    scene
+}
+
+#[test]
+fn blender_second_light_highlight() {
+    if !have("blender", "Blender") {
+        return;
+    }
+    let phong = render_all("phong", &[two_lights(true), two_lights(false)]);
+    let other = render_all("blender", &[two_lights(true)]);
+    let a = agreement(&phong[0], &phong[1], &other[0]);
+    eprintln!(
+        "blender, two lights: highlight {} px {:.2} %, image {:.3} %, green peak phong {} blender {}",
+        a.pixels, a.highlight, a.image, a.peak.0, a.peak.1
+    );
+    assert!(a.pixels >= 10, "both highlights must show");
+    assert!(a.highlight <= 3.0, "highlight {:.2} %", a.highlight);
+    assert!(a.image <= 1.0, "image {:.3} %", a.image);
 }
