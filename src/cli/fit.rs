@@ -7,6 +7,7 @@ use crate::fit::{self, FitTarget};
 use crate::raster::Encoding;
 use crate::render::from_spec_with;
 use crate::rundir::Mode;
+use crate::scene::memory::Population;
 use crate::scene::{load_with, Override, Scene};
 use clap::Args;
 use std::path::PathBuf;
@@ -118,7 +119,12 @@ pub fn run(a: FitArgs) -> Result<()> {
     let file = a.inputs.scene.display().to_string();
     let (w, h) = (scene.image.width, scene.image.height);
     let avail = crate::scene::memory::available();
-    crate::scene::memory::check_fit(avail, &file, w, h, config.de.population, config.jobs)?;
+    let pop = Population {
+        option: "--population",
+        size: config.de.population,
+        copies: 1,
+    };
+    crate::scene::memory::check_fit(avail, &file, (w, h), pop, config.jobs)?;
     config.mode = run_mode(a.resume, a.overwrite);
     if let Some(m) = &a.inputs.mask {
         config.inputs.push(("--mask".into(), m.clone()));
@@ -160,8 +166,12 @@ fn run_set(a: &FitArgs, scene: &Scene, shots: &[crate::fit::set::shots::Shot]) -
     let file = a.inputs.scene.display().to_string();
     let (w, h) = (scene.image.width, scene.image.height);
     let avail = crate::scene::memory::available();
-    let candidates = config.de.population * shots.len();
-    crate::scene::memory::check_fit(avail, &file, w, h, candidates, config.jobs)?;
+    let pop = Population {
+        option: "--population",
+        size: config.de.population,
+        copies: shots.len(),
+    };
+    crate::scene::memory::check_fit(avail, &file, (w, h), pop, config.jobs)?;
     config.mode = run_mode(a.resume, a.overwrite);
     config.interrupt = Some(interrupt_flag());
     let set = fit::set::SetConfig {

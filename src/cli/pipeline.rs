@@ -13,6 +13,7 @@ use crate::fit::{GenerationReport, Observer};
 use crate::pipeline::{self, Iteration, MappedBudget, PipelineConfig, Stage2Method, StageObserver};
 use crate::render::{from_spec_with, RenderOptions, Renderer};
 use crate::report::{self, ReportOptions};
+use crate::scene::memory::Population;
 use crate::scene::{load_with, Override};
 use clap::Args;
 use std::path::{Path, PathBuf};
@@ -110,8 +111,16 @@ pub fn run(a: PipelineArgs) -> Result<()> {
     let file = a.inputs.scene.display().to_string();
     let (w, h) = (scene.image.width, scene.image.height);
     let avail = crate::scene::memory::available();
-    for c in [&stage1, &stage2] {
-        crate::scene::memory::check_fit(avail, &file, w, h, c.de.population, c.jobs)?;
+    for (c, option) in [
+        (&stage1, "--stage1-population"),
+        (&stage2, "--stage2-population"),
+    ] {
+        let pop = Population {
+            option,
+            size: c.de.population,
+            copies: 1,
+        };
+        crate::scene::memory::check_fit(avail, &file, (w, h), pop, c.jobs)?;
     }
     stage1.interrupt = Some(interrupt.clone());
     stage2.interrupt = Some(interrupt);
