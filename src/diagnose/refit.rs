@@ -155,7 +155,8 @@ impl<'a> Refits<'a> {
     }
 
     /// The one call into `crate::fit`: fits `scene`'s free parameters
-    /// with SHADE and returns the fitted scene and its image.
+    /// with the hybrid search, ended once it has settled (its generations
+    /// a cap), and returns the fitted scene and its image.
     fn fit(&mut self, scene: &Scene, refine: Refine) -> Result<(Scene, Image)> {
         let config = FitConfig {
             generations: refine.generations,
@@ -163,14 +164,20 @@ impl<'a> Refits<'a> {
             de: DeConfig {
                 population: refine.population,
                 seed: self.config.seed,
-                // Current-to-pbest: every refit starts from a good point,
-                // which SHADE exploits; DE/rand/1 spent whole polishes
-                // without improving on their start.
-                strategy: crate::optimize::Strategy::Shade,
+                // Every refit starts from a good point: SHADE's
+                // current-to-pbest exploits it, and the local phase does
+                // the last digits in a few Jacobians where SHADE spent
+                // most of a fixed budget (DE/rand/1 spent whole polishes
+                // without improving on their start).
+                strategy: crate::optimize::Strategy::Hybrid,
                 ..DeConfig::default()
             },
             jobs: self.config.jobs,
             snapshot_every: usize::MAX / 2,
+            // A refit costs what it needs: it ends when the local phase
+            // converges, so refits compared by the criterion each reach
+            // their minimum rather than spend one fixed budget.
+            settle: true,
             ..FitConfig::default()
         };
         let r = fit::run_in_memory(scene, &self.target, self.renderer, &config, &mut ())?;

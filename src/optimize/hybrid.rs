@@ -50,6 +50,13 @@
 //! only when nothing can move any more: the fitness is 0, or a local run
 //! gained nothing and the population has collapsed onto one point.
 //!
+//! **Settling** ([`Hybrid::settle`], for refits that need an answer, not
+//! a budget spent): the run also ends once a local run from the global
+//! best has gained less than [`SETTLED_GAIN`] while the better half of the
+//! population sits in one basin (the point is a minimum both phases agree
+//! on), or once a periodic trial finds neither a better best nor another
+//! basin to start from (nothing is left to try).
+//!
 //! Everything is deterministic (the only random numbers are SHADE's, drawn
 //! from its seeded generator) and serialisable, floats bit-exact, so a run
 //! resumed from a checkpoint in either phase continues identically.
@@ -83,6 +90,9 @@ pub const LAMBDA_MAX: f64 = 1e8;
 /// A local run from a population member other than the best starts only
 /// this far (max-norm, unit cube) from every earlier start and end.
 pub const START_SEPARATION: f64 = 0.05;
+/// A settling run ends after a local run from the global best gaining less
+/// than this fraction of its start's fitness (see the module docs).
+pub const SETTLED_GAIN: f64 = 1e-3;
 /// Largest per-coordinate spread of a population collapsed onto one point.
 const COLLAPSED: f64 = 1e-12;
 
@@ -135,6 +145,9 @@ pub struct Hybrid {
     /// The normal equations at the best point, once the local phase has
     /// evaluated it.
     at_best: Option<Normal>,
+    /// Whether the run ends once settled (see the module docs).
+    #[serde(default)]
+    settle: bool,
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -180,10 +193,13 @@ struct Local {
     rate_floor: f64,
     /// Set when the run ended because the global phase was faster.
     outpaced: bool,
+    /// Whether it started from the global best (not another basin).
+    #[serde(default)]
+    from_best: bool,
 }
 
 impl Local {
-    fn start(x: Vec<f64>, steps: Vec<f64>, rate_floor: f64) -> Local {
+    fn start(x: Vec<f64>, steps: Vec<f64>, rate_floor: f64, from_best: bool) -> Local {
         let batch = neighbourhood(&x, &steps);
         Local {
             x,
@@ -197,6 +213,7 @@ impl Local {
             history: Vec::new(),
             rate_floor,
             outpaced: false,
+            from_best,
         }
     }
 
@@ -396,7 +413,14 @@ impl Hybrid {
             starts: Vec::new(),
             ends: Vec::new(),
             at_best: None,
+            settle: false,
         }
+    }
+
+    /// Ends the run once it has settled (see the module docs) rather than
+    /// only by the executor's budget or target.
+    pub fn settle(&mut self) {
+        self.settle = true;
     }
 
     /// The config in use.
@@ -455,14 +479,20 @@ impl Hybrid {
         if !(fitness.is_finite() && (due || periodic)) {
             return;
         }
-        let start = if fitness < self.local_end || self.outpaced {
+        let from_best = fitness < self.local_end || self.outpaced;
+        let start = if from_best {
             point
         } else if periodic {
             // The best point is where a local run stalled: try the best
             // member of another basin, if the population still has one.
             match self.fresh_point() {
                 Some(other) => other,
-                None => return,
+                None => {
+                    if self.settle {
+                        self.phase = Phase::Done;
+                    }
+                    return;
+                }
             }
         } else {
             return;
@@ -474,7 +504,7 @@ impl Hybrid {
             0.0
         };
         self.starts.push(start.clone());
-        self.phase = Phase::Local(Local::start(start, self.steps.clone(), rate));
+        self.phase = Phase::Local(Local::start(start, self.steps.clone(), rate, from_best));
     }
 
     /// The best population member farther than [`START_SEPARATION`]
@@ -520,7 +550,12 @@ impl Hybrid {
         let gained = local.fitness < local.start_fitness;
         self.global.inject(&local.x, local.fitness);
         let stuck = !gained && collapsed(self.global.population(), self.global.fitness());
-        self.phase = if local.fitness == 0.0 || stuck {
+        let settled = self.settle && local.from_best && !local.outpaced && {
+            let gain = 1.0 - local.fitness / local.start_fitness;
+            let spreads = basin_spreads(self.global.population(), self.global.fitness());
+            (gain.is_nan() || gain < SETTLED_GAIN) && found_basin(&spreads)
+        };
+        self.phase = if local.fitness == 0.0 || stuck || settled {
             Phase::Done
         } else {
             self.stint_generation = self.global.generation();
