@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # Renders needed by `--strategy shade` and `--strategy hybrid` to reach a
-# deviation of 0.1 % and 0.01 % on two scenes with a hidden truth, seeds
+# deviation of 0.1 % and 0.01 % on three scenes with a hidden truth
+# (glossy_effects: the harder landscape of fresnel, a second specular lobe
+# and the camera's response free besides the light and the colour), seeds
 # 1..N. Prints one line per run, then a summary per scene, strategy and
 # target (median and range over the runs that reached it, reached count).
 #
@@ -13,7 +15,7 @@ seeds=${1:-10}
 out=${2:-/tmp/bench-hybrid}
 bin=${SCENEFIT:-target/release/scenefit}
 strategies=${STRATEGIES:-"shade hybrid"}
-scenes=${SCENES:-"paper_box sphere_floor"}
+scenes=${SCENES:-"paper_box sphere_floor glossy_effects"}
 targets=${TARGETS:-"0.1 0.01"}
 jobs=${JOBS:-2}
 mkdir -p "$out"
@@ -33,6 +35,15 @@ truth_sphere_floor=(
   --set 'lights.key.position=[1.4,3.6,2.5]'
   --set lights.key.intensity=14
   --set 'objects.ball.material.color=[0.3,0.6,0.8]'
+)
+truth_glossy_effects=(
+  "${truth_sphere_floor[@]}"
+  --set objects.ball.material.specular=0.4
+  --set objects.ball.material.shininess=60
+  --set objects.ball.material.fresnel=0.2
+  --set objects.ball.material.specular2=0.3
+  --set camera.response.gamma=1.3
+  --set camera.response.black=0.02
 )
 
 echo "# $(date -u '+%Y-%m-%d %H:%M UTC'); load: $(uptime | sed 's/.*load average: //')"
