@@ -8,7 +8,9 @@
 #
 # Usage: scripts/bench-hybrid.sh [SEEDS=10] [OUTDIR=/tmp/bench-hybrid]
 # Env: SCENEFIT (binary; default target/release/scenefit), STRATEGIES,
-#      SCENES, TARGETS (space-separated lists), JOBS (default 2).
+#      SCENES, TARGETS (space-separated lists), JOBS (default 2),
+#      FIRST_SEED (default 1: seeds FIRST_SEED..SEEDS, so that a long
+#      bench can run one seed at a time).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seeds=${1:-10}
@@ -18,6 +20,7 @@ strategies=${STRATEGIES:-"shade hybrid"}
 scenes=${SCENES:-"paper_box sphere_floor glossy_effects"}
 targets=${TARGETS:-"0.1 0.01"}
 jobs=${JOBS:-2}
+first_seed=${FIRST_SEED:-1}
 mkdir -p "$out"
 
 # The hidden truths (inside each scene's free bounds).
@@ -54,7 +57,7 @@ for scene in $scenes; do
   "$bin" render "scenes/$scene.json" -o "$out/$scene-target.png" "${!truth}" >/dev/null
   for strategy in $strategies; do
     for target in $targets; do
-      for seed in $(seq 1 "$seeds"); do
+      for seed in $(seq "$first_seed" "$seeds"); do
         dir="$out/$scene-$strategy-$target-$seed"
         "$bin" fit "scenes/$scene.json" --target "$out/$scene-target.png" -o "$dir" \
           --overwrite --strategy "$strategy" --seed "$seed" \
