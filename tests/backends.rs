@@ -102,6 +102,9 @@ fn fit_recovers(renderer: &str) {
             "8",
             "--generations",
             "8",
+            // The threshold below was measured with the paper's search.
+            "--strategy",
+            "rand1bin",
             "--seed",
             "1",
             "-q",

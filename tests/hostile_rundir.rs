@@ -196,6 +196,9 @@ fn two_runs_never_share_a_directory() {
         "400",
         "--population",
         "20",
+        // All 400 generations run (the hybrid may end a converged run early).
+        "--strategy",
+        "rand1bin",
         "-q",
     ];
     let mut first = Command::new(bin)

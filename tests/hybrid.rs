@@ -408,3 +408,41 @@ fn a_finished_local_run_hands_its_point_back_to_the_global_phase() {
         .any(|(x, &f)| bits(x) == bits(best) && f.to_bits() == best_fitness.to_bits());
     assert!(held, "the local run's best point is not in the population");
 }
+
+#[test]
+fn a_settling_hybrid_ends_near_the_minimum_without_spending_its_budget() {
+    // As a diagnosis refit runs: warm, around a point near the truth.
+    let problem = Blobs::new(&blob_truth());
+    let center: Vec<f64> = blob_truth().iter().map(|v| v + 0.03).collect();
+    let start = Start::Around {
+        center: &center,
+        radius: 0.2,
+    };
+    let budget = 40_000;
+    for seed in 1..=3 {
+        let mut settling = Searcher::new(12, &config(Strategy::Hybrid, seed), start);
+        settling.settle();
+        run(&mut settling, &problem, 0.0, budget);
+        let mut full = Searcher::new(12, &config(Strategy::Hybrid, seed), start);
+        run(&mut full, &problem, 0.0, budget);
+        eprintln!(
+            "seed {seed}: settled after {} evaluations at {:.5}, the full budget {} at {:.5}",
+            settling.evaluations(),
+            settling.best().1,
+            full.evaluations(),
+            full.best().1
+        );
+        assert!(settling.converged(), "seed {seed}: never settled");
+        assert!(
+            settling.evaluations() * 4 <= budget,
+            "seed {seed}: settled after {} of {budget} evaluations",
+            settling.evaluations(),
+        );
+        assert!(
+            settling.best().1 <= (2.0 * full.best().1).max(BLOB_TARGET),
+            "seed {seed}: settled at {}, the full budget reached {}",
+            settling.best().1,
+            full.best().1
+        );
+    }
+}

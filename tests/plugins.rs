@@ -406,6 +406,9 @@ fn generation_that_fails_entirely_stops_the_run_and_resume_continues() {
         "6",
         "--generations",
         "6",
+        // All 6 generations run (the hybrid may end a converged run early).
+        "--strategy",
+        "rand1bin",
         "-q",
     ];
     // the renderer breaks: every render of the first generation fails

@@ -65,6 +65,9 @@ pub struct FitConfig {
     /// Input files besides the target (a mask) that the run must not
     /// overwrite, with the option that named each.
     pub inputs: Vec<(String, PathBuf)>,
+    /// End a hybrid search once it has settled
+    /// ([`crate::optimize::Hybrid::settle`]), the generations a cap only.
+    pub settle: bool,
 }
 
 impl Default for FitConfig {
@@ -83,6 +86,7 @@ impl Default for FitConfig {
             snapshot_every: 10,
             interrupt: None,
             inputs: Vec::new(),
+            settle: false,
         }
     }
 }
@@ -421,7 +425,11 @@ fn new_search(config: &FitConfig, sub: &ParamSpace, base: &Scene, phase_index: u
         },
         None => Start::Uniform,
     };
-    Searcher::new(sub.dim(), &de, start)
+    let mut search = Searcher::new(sub.dim(), &de, start);
+    if config.settle {
+        search.settle();
+    }
+    search
 }
 
 /// Generations for each phase; every phase gets at least one.

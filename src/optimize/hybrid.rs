@@ -50,6 +50,22 @@
 //! only when nothing can move any more: the fitness is 0, or a local run
 //! gained nothing and the population has collapsed onto one point.
 //!
+//! **Settling** ([`Hybrid::settle`], for refits that need an answer, not
+//! a budget spent): the run also ends once both phases agree they are done
+//! — a local run from the global best gained less than [`SETTLED_GAIN`],
+//! after a global stint that also gained less than that, with the better
+//! half of the population in one basin — or once the global best has
+//! stood through [`SETTLE_TRIES`] local runs from other basins (or no
+//! other basin is left to try). A local run stalling alone is not enough:
+//! on 8-bit images it stalls in narrow valleys (a light's falloff against
+//! its intensity and position) that the population still descends. And a
+//! settling run hands over the first time only when the population has
+//! found its basin, never periodically: a local run from an early best,
+//! handed back, becomes the p-best every SHADE trial moves towards, so the
+//! population follows it into its basin; a refit from scratch exists to
+//! find another basin (with the periodic trial, a diagnosis's refits of a
+//! light's falloff stopped at half the SAD drop SHADE alone reached).
+//!
 //! Everything is deterministic (the only random numbers are SHADE's, drawn
 //! from its seeded generator) and serialisable, floats bit-exact, so a run
 //! resumed from a checkpoint in either phase continues identically.
@@ -83,6 +99,12 @@ pub const LAMBDA_MAX: f64 = 1e8;
 /// A local run from a population member other than the best starts only
 /// this far (max-norm, unit cube) from every earlier start and end.
 pub const START_SEPARATION: f64 = 0.05;
+/// A settling run ends after a local run from the global best gaining less
+/// than this fraction of its start's fitness (see the module docs).
+pub const SETTLED_GAIN: f64 = 1e-3;
+/// A settling run ends once this many local runs in a row from other
+/// basins have not bettered the global best by [`SETTLED_GAIN`].
+pub const SETTLE_TRIES: usize = 2;
 /// Largest per-coordinate spread of a population collapsed onto one point.
 const COLLAPSED: f64 = 1e-12;
 
@@ -135,6 +157,12 @@ pub struct Hybrid {
     /// The normal equations at the best point, once the local phase has
     /// evaluated it.
     at_best: Option<Normal>,
+    /// Whether the run ends once settled (see the module docs).
+    #[serde(default)]
+    settle: bool,
+    /// Local runs from other basins since one bettered the global best.
+    #[serde(default)]
+    fresh_tries: usize,
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -180,10 +208,14 @@ struct Local {
     rate_floor: f64,
     /// Set when the run ended because the global phase was faster.
     outpaced: bool,
+    /// Whether it started from the global best after a global stint that
+    /// gained less than [`SETTLED_GAIN`] (the global phase is done there).
+    #[serde(default)]
+    global_done: bool,
 }
 
 impl Local {
-    fn start(x: Vec<f64>, steps: Vec<f64>, rate_floor: f64) -> Local {
+    fn start(x: Vec<f64>, steps: Vec<f64>, rate_floor: f64, global_done: bool) -> Local {
         let batch = neighbourhood(&x, &steps);
         Local {
             x,
@@ -197,6 +229,7 @@ impl Local {
             history: Vec::new(),
             rate_floor,
             outpaced: false,
+            global_done,
         }
     }
 
@@ -396,7 +429,15 @@ impl Hybrid {
             starts: Vec::new(),
             ends: Vec::new(),
             at_best: None,
+            settle: false,
+            fresh_tries: 0,
         }
+    }
+
+    /// Ends the run once it has settled (see the module docs) rather than
+    /// only by the executor's budget or target.
+    pub fn settle(&mut self) {
+        self.settle = true;
     }
 
     /// The config in use.
@@ -451,17 +492,29 @@ impl Hybrid {
             self.global.population(),
             self.global.fitness(),
         ));
-        let periodic = self.global.generation() >= self.stint_generation + TRIAL_EVERY;
+        // A settling run's first local run waits for the population's own
+        // basin (see the module docs).
+        let patient = self.settle && self.starts.is_empty();
+        let periodic = !patient && self.global.generation() >= self.stint_generation + TRIAL_EVERY;
         if !(fitness.is_finite() && (due || periodic)) {
             return;
         }
-        let start = if fitness < self.local_end || self.outpaced {
+        let from_best = fitness < self.local_end || self.outpaced;
+        let start = if from_best {
             point
         } else if periodic {
             // The best point is where a local run stalled: try the best
             // member of another basin, if the population still has one.
-            match self.fresh_point() {
-                Some(other) => other,
+            let fresh = self.fresh_point();
+            if self.settle && (fresh.is_none() || self.fresh_tries >= SETTLE_TRIES) {
+                self.phase = Phase::Done;
+                return;
+            }
+            match fresh {
+                Some(other) => {
+                    self.fresh_tries += 1;
+                    other
+                }
                 None => return,
             }
         } else {
@@ -474,7 +527,12 @@ impl Hybrid {
             0.0
         };
         self.starts.push(start.clone());
-        self.phase = Phase::Local(Local::start(start, self.steps.clone(), rate));
+        // Only a stint after a local run counts: the first one began at
+        // the first generation, not where the phases last agreed.
+        let global_done = from_best
+            && !self.ends.is_empty()
+            && fitness >= self.stint_fitness * (1.0 - SETTLED_GAIN);
+        self.phase = Phase::Local(Local::start(start, self.steps.clone(), rate, global_done));
     }
 
     /// The best population member farther than [`START_SEPARATION`]
@@ -513,6 +571,9 @@ impl Hybrid {
             return;
         }
         self.steps = local.steps.clone();
+        if local.fitness < self.local_end * (1.0 - SETTLED_GAIN) {
+            self.fresh_tries = 0;
+        }
         // The best end so far is where the next run would stall again.
         self.outpaced = local.outpaced && local.fitness <= self.local_end;
         self.local_end = self.local_end.min(local.fitness);
@@ -520,7 +581,12 @@ impl Hybrid {
         let gained = local.fitness < local.start_fitness;
         self.global.inject(&local.x, local.fitness);
         let stuck = !gained && collapsed(self.global.population(), self.global.fitness());
-        self.phase = if local.fitness == 0.0 || stuck {
+        let settled = self.settle && local.global_done && !local.outpaced && {
+            let gain = 1.0 - local.fitness / local.start_fitness;
+            let spreads = basin_spreads(self.global.population(), self.global.fitness());
+            (gain.is_nan() || gain < SETTLED_GAIN) && found_basin(&spreads)
+        };
+        self.phase = if local.fitness == 0.0 || stuck || settled {
             Phase::Done
         } else {
             self.stint_generation = self.global.generation();

@@ -148,6 +148,14 @@ impl Searcher {
         }
     }
 
+    /// Makes a hybrid search end once it has settled ([`Hybrid::settle`]);
+    /// a DE search is left as it is.
+    pub fn settle(&mut self) {
+        if let Searcher::Hybrid(h) = self {
+            h.settle();
+        }
+    }
+
     /// The strategy this search runs.
     pub fn strategy(&self) -> Strategy {
         match self {
