@@ -199,12 +199,8 @@ fn noise_only_and_a_single_photograph_do_not_accept_the_map() {
     let one = tempfile::tempdir().unwrap();
     make_set(one.path(), 1, true, 0.0);
     let d = fit_and_diagnose(one.path(), false);
+    // One photograph gives no value two equations: nothing is solved.
     assert!(!accepted(&d).contains(&"albedo_map".to_string()), "{d:#}");
-    let tried = d["candidates"].as_array().unwrap();
-    assert!(
-        tried.iter().any(|c| c["effect"] == "albedo_map"),
-        "not tried"
-    );
 }
 
 #[test]

@@ -5,14 +5,14 @@
 //! dark) in linear values), so each pixel's channel is solved on its own
 //! over the photographs: the weighted median of (target - dark) / (lit -
 //! dark), weighted by lit - dark, which minimises the sum of absolute
-//! differences (the fit's metric) in linear values. Values with too little
-//! evidence stay 1 and are not counted.
+//! differences (the fit's metric) in linear values. Values with evidence
+//! in fewer than two photographs stay 1 and are not counted, so on a
+//! single photograph nothing is solved and the effect is no candidate.
 //!
 //! The map is solved, the model's other free parameters refitted with it
 //! in the scene, and the map solved once more against the refitted model
 //! (the better of the two kept). Its parameters for the criterion are the
-//! values solved: on one photograph the map can explain every lit pixel
-//! (one equation per unknown), and pays for each.
+//! values solved, ln N each.
 
 use super::refit::{Model, Refine, Refits};
 use super::selection::{bic, samples};
@@ -34,6 +34,9 @@ pub const NAME: &str = "albedo_map";
 /// photograph to count as evidence at a pixel's channel (about one
 /// 8-bit step at mid-grey; below it quantisation dominates the ratio).
 const MIN_DIFFUSE: f64 = 0.01;
+
+/// Photographs with evidence a value needs.
+const MIN_PHOTOGRAPHS: usize = 2;
 
 /// Multipliers are clamped to this (a pixel lit far less than the model
 /// says, e.g. a shadow the model misses, is not a map).
@@ -83,14 +86,16 @@ fn linear_table(response: Option<Response>) -> Vec<f64> {
 }
 
 /// Solves the map from every photograph's evidence (linear values, the
-/// `response` undone); a value needs evidence in at least two photographs
-/// (one when there is only one). Saturated pixels (255 in the target or
-/// the lit render) are no evidence.
+/// `response` undone); a value needs evidence in at least two photographs:
+/// from one, a value would match its pixel exactly whatever caused the
+/// difference (a stain or a shadow the model lacks), which no criterion
+/// over those pixels can tell from a texture (on noise-free photographs
+/// the BIC accepted such a map on one photograph). Saturated pixels (255
+/// in the target or the lit render) are no evidence.
 pub fn solve(evidence: &[Evidence], response: Option<Response>) -> Solved {
     let (w, h) = evidence[0].target.dimensions();
     let lin = linear_table(response);
     let mut map = AlbedoMap::uniform(w, h, 1.0);
-    let need = evidence.len().min(2);
     let mut count = 0;
     let mut ratios: Vec<(f64, f64)> = Vec::with_capacity(evidence.len());
     // Which pixels each photograph counts.
@@ -122,7 +127,7 @@ pub fn solve(evidence: &[Evidence], response: Option<Response>) -> Solved {
                 }
                 ratios.push(((lin[t as usize] - lin[d as usize]) / diffuse, diffuse));
             }
-            if ratios.len() >= need && need > 0 {
+            if ratios.len() >= MIN_PHOTOGRAPHS {
                 map.values[i] = weighted_median(&mut ratios).clamp(0.0, MAX_MULTIPLIER) as f32;
                 count += 1;
             }
