@@ -18,6 +18,7 @@
 //! smooth structure remains in the residual. Inputs come from a fit
 //! directory (`inputs.rs`); the files written are named in `output.rs`.
 
+mod albedo;
 mod config;
 pub mod effects;
 mod inputs;
@@ -99,7 +100,7 @@ pub fn run(inputs: &Inputs, out: &Path, config: &DiagnoseConfig) -> Result<Diagn
     let mut candidates = Vec::new();
     let mut accepted: Vec<String> = Vec::new();
     for round in 1..=config.max_rounds {
-        let found = run_round(&mut fits, &model, &accepted, round)?;
+        let found = run_round(&mut fits, &model, &accepted, round, out)?;
         candidates.extend(found.candidates);
         let Some((name, next)) = found.accepted else {
             break;
@@ -143,7 +144,13 @@ struct Round {
 
 /// One round: every applicable effect not yet accepted, extended, refitted
 /// and scored; the criterion chooses.
-fn run_round(fits: &mut Refits, model: &Model, accepted: &[String], round: usize) -> Result<Round> {
+fn run_round(
+    fits: &mut Refits,
+    model: &Model,
+    accepted: &[String],
+    round: usize,
+    out: &Path,
+) -> Result<Round> {
     let inputs = fits.inputs;
     let residual = Residual::new(&inputs.target, &model.image, inputs.mask.as_ref());
     let mut tried: Vec<(Candidate, Model)> = Vec::new();
@@ -152,7 +159,16 @@ fn run_round(fits: &mut Refits, model: &Model, accepted: &[String], round: usize
             continue;
         }
         let evidence = residual.evidence(effect);
-        if let Some((c, m)) = try_effect(fits, model, effect, round)? {
+        let found = if effect.closed_form() {
+            if effect.applies(&model.scene) {
+                albedo::candidate(fits, model, round, out)?
+            } else {
+                None
+            }
+        } else {
+            try_effect(fits, model, effect, round)?
+        };
+        if let Some((c, m)) = found {
             tried.push((Candidate { evidence, ..c }, m));
         }
     }

@@ -29,7 +29,7 @@ use serde::Serialize;
 use std::path::Path;
 use std::time::Instant;
 
-type Params = serde_json::Map<String, serde_json::Value>;
+pub(super) type Params = serde_json::Map<String, serde_json::Value>;
 
 /// A set fit's outputs, as a diagnosis starts from them.
 pub struct SetInputs {
@@ -139,7 +139,7 @@ impl SetModel {
 
 /// Each photograph as a shot of `scene`: its `set` values and then its
 /// own values `own` in place.
-fn shots_of(scene: &Scene, inputs: &SetInputs, own: &[Params]) -> Result<Vec<Shot>> {
+pub(super) fn shots_of(scene: &Scene, inputs: &SetInputs, own: &[Params]) -> Result<Vec<Shot>> {
     inputs
         .shots
         .iter()
@@ -162,17 +162,19 @@ fn shots_of(scene: &Scene, inputs: &SetInputs, own: &[Params]) -> Result<Vec<Sho
 }
 
 /// Runs the refits of a set diagnosis and counts their renders.
-struct SetRefits<'a> {
+pub(super) struct SetRefits<'a> {
     renderer: &'a dyn Renderer,
-    inputs: &'a SetInputs,
+    pub(super) inputs: &'a SetInputs,
     config: &'a DiagnoseConfig,
     renders: usize,
+    /// The diagnosis's directory (closed-form effects write their maps there).
+    pub(super) out: &'a Path,
 }
 
 impl SetRefits<'_> {
     /// Renders `scene` with every photograph's `own` values: the images
     /// and the set's sum of absolute differences (None: a render failed).
-    fn render(&mut self, shots: &[Shot]) -> Result<Option<(Vec<Image>, f64)>> {
+    pub(super) fn render(&mut self, shots: &[Shot]) -> Result<Option<(Vec<Image>, f64)>> {
         let scenes: Vec<Scene> = shots.iter().map(|s| s.scene.clone()).collect();
         let space = ParamSpace::from_scene(&scenes[0]);
         let mut session = self
@@ -253,7 +255,7 @@ impl SetRefits<'_> {
     }
 
     /// `scene` (with `own` values) refitted over the set.
-    fn run(&mut self, scene: &Scene, own: &[Params]) -> Result<SetModel> {
+    pub(super) fn run(&mut self, scene: &Scene, own: &[Params]) -> Result<SetModel> {
         let shots = shots_of(scene, self.inputs, own)?;
         let c = self.config;
         let config = SetConfig {
@@ -345,6 +347,7 @@ pub fn run(inputs: &SetInputs, out: &Path, config: &DiagnoseConfig) -> Result<Se
         inputs,
         config,
         renders: inputs.shots.len(),
+        out,
     };
     let null = fits.run(&model0.scene, &model0.own)?;
     let mut model = model0.clone().better(null);
@@ -418,12 +421,25 @@ fn rounds(
             if accepted.iter().any(|a| a == effect.name()) {
                 continue;
             }
-            let Some(ext) = effects::extend(effect, &model.scene) else {
-                continue;
+            let (fitted, k) = if effect.closed_form() {
+                let solved = match effect.applies(&model.scene) {
+                    true => super::albedo::set_model(fits, model, round)?,
+                    false => None,
+                };
+                let Some((fitted, values)) = solved else {
+                    continue;
+                };
+                let k = fitted.dim(inputs) + values;
+                (fitted, k)
+            } else {
+                let Some(ext) = effects::extend(effect, &model.scene) else {
+                    continue;
+                };
+                let (start, own) = fits.best_start(&ext, &model.own)?;
+                let fitted = fits.run(&start, &own)?;
+                let k = fitted.dim(inputs);
+                (fitted, k)
             };
-            let (start, own) = fits.best_start(&ext, &model.own)?;
-            let fitted = fits.run(&start, &own)?;
-            let k = fitted.dim(inputs);
             let candidate = Candidate {
                 effect: effect.name().to_string(),
                 evidence: evidence(&residuals, effect),

@@ -8,7 +8,8 @@
 //! Refused: a Mitsuba area light (`radius` > 0: a shape with an area
 //! emitter) with a falloff other than 1/d^2, and `fresnel` or `specular2` on a
 //! transmitting material (glass is drawn by the principled BSDF, with its
-//! own Fresnel term and one lobe). `indirect_light` is the built-in
+//! own Fresnel term and one lobe), and `albedo_map` (a map in the image's
+//! frame, drawn by the built-in tracer only). `indirect_light` is the built-in
 //! tracer's stand-in for what `render.indirect` traces: not refused.
 
 use crate::error::{Error, Result};
@@ -36,6 +37,12 @@ pub fn check(scene: &Scene, backend: &str) -> Result<()> {
     }
     for o in &scene.objects {
         let m = &o.material;
+        if m.albedo_map.is_some() {
+            return refuse(
+                format!("objects.{}.material.albedo_map", o.name),
+                "an albedo map in the image's frame is drawn by phong only; use phong",
+            );
+        }
         if m.transmission <= 0.0 {
             continue;
         }

@@ -134,7 +134,7 @@ pub fn from_value(value: serde_json::Value, file: &str) -> Result<Scene> {
             ),
         )
     })?;
-    let scene: Scene = serde_path_to_error::deserialize(value).map_err(|e| {
+    let mut scene: Scene = serde_path_to_error::deserialize(value).map_err(|e| {
         let key = e.path().to_string();
         let key = if key == "." {
             "(top level)".to_string()
@@ -151,6 +151,11 @@ pub fn from_value(value: serde_json::Value, file: &str) -> Result<Scene> {
         };
         Error::invalid(file, key, message)
     })?;
+    for o in &mut scene.objects {
+        if let Some(p) = o.material.albedo_map.as_mut() {
+            *p = super::albedo_map::resolve(p, file).display().to_string();
+        }
+    }
     validate(&scene, file)?;
     Ok(scene)
 }

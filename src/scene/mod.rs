@@ -2,6 +2,7 @@
 //! loading with validation, numeric fields addressed by name, and the
 //! parameter space that maps the `free` list to a search vector and back.
 
+pub mod albedo_map;
 pub mod color;
 pub mod field;
 pub mod limits;

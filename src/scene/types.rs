@@ -261,6 +261,11 @@ pub struct Material {
     pub specular2: Option<f64>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub shininess2: Option<f64>,
+    /// An OpenEXR image of the camera's size multiplying the diffuse
+    /// colour per pixel, in the image's frame (`albedo_map.rs`); made
+    /// absolute when the scene is read.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub albedo_map: Option<String>,
 }
 
 fn one() -> f64 {

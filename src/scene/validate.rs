@@ -31,7 +31,21 @@ pub fn validate(scene: &Scene, file: &str) -> Result<()> {
     effects(scene, file)?;
     lights(scene, file)?;
     objects(scene, file)?;
+    albedo_maps(scene, file)?;
     free_list(scene, file)
+}
+
+/// Every `material.albedo_map`: an OpenEXR file of the image's size with
+/// finite non-negative values (read once, `albedo_map.rs`).
+fn albedo_maps(scene: &Scene, file: &str) -> Result<()> {
+    let size = (scene.image.width, scene.image.height);
+    for (i, o) in scene.objects.iter().enumerate() {
+        if let Some(p) = &o.material.albedo_map {
+            let key = format!("objects[{i}].material.albedo_map");
+            super::albedo_map::check(std::path::Path::new(p), size, file, &key)?;
+        }
+    }
+    Ok(())
 }
 
 /// The format tag, image size and render settings.

@@ -6,6 +6,7 @@
 //! freed, where else its search may start, and which fitted parameters it
 //! trades with. Adding an effect: its module, and one line in [`ALL`].
 
+mod albedo_map;
 mod ambient;
 mod area_light;
 mod camera_response;
@@ -49,8 +50,18 @@ pub trait Effect: Sync {
         Trades::default()
     }
 
+    /// True for an effect solved in closed form rather than searched (one
+    /// value per pixel: `albedo_map`, solved in `diagnose/albedo.rs`); its
+    /// `extend` adds no free entries.
+    fn closed_form(&self) -> bool {
+        false
+    }
+
     /// True when it can be added to `scene`.
     fn applies(&self, scene: &Scene) -> bool {
+        if self.closed_form() {
+            return self.extend(scene).is_some();
+        }
         self.extend(scene)
             .is_some_and(|(_, added)| !added.is_empty())
     }
@@ -67,6 +78,7 @@ pub static ALL: &[&dyn Effect] = &[
     &indirect_light::IndirectLight,
     &fresnel::Fresnel,
     &specular_lobe::SpecularLobe,
+    &albedo_map::AlbedoMap,
 ];
 
 /// The names of [`ALL`], in order.
@@ -123,7 +135,7 @@ mod tests {
         for (i, a) in n.iter().enumerate() {
             assert!(!n[i + 1..].contains(a), "{a} twice");
         }
-        for &e in ALL {
+        for &e in ALL.iter().filter(|e| !e.closed_form()) {
             let ext = extend(e, &scene).unwrap_or_else(|| panic!("{} does not apply", e.name()));
             // Every added entry resolves in the extended scene to the
             // field it was written from.

@@ -6,7 +6,7 @@
 //!
 //! Reads from the scene: `camera`, `image`, `ambient`, `indirect_light`,
 //! `lights` (with `radius` for soft shadows and `falloff_power`), `objects`
-//! (with `fresnel`, `specular2`, `shininess2`), `render.antialias`,
+//! (with `fresnel`, `specular2`, `shininess2`, `albedo_map`), `render.antialias`,
 //! `render.max_depth`. The camera's `vignetting` and `response` are applied
 //! after any renderer (render/camera_effects.rs).
 //!
@@ -87,11 +87,12 @@ impl PhongSession {
     fn render(&self, scene: &Scene) -> RenderResult {
         let (w, h) = (scene.image.width, scene.image.height);
         let mut buf = vec![0u8; (w * h * 3) as usize];
+        let maps = shade::albedo_maps(scene)?;
         match &self.cached {
-            Some(p) => shade::shade(&p.paths, &p.packed, scene, &mut buf),
+            Some(p) => shade::shade(&p.paths, &p.packed, scene, &maps, &mut buf),
             None => {
                 let p = Prepared::new(scene, &self.variation);
-                shade::shade(&p.paths, &p.packed, scene, &mut buf)
+                shade::shade(&p.paths, &p.packed, scene, &maps, &mut buf)
             }
         }
         Ok(Image::from_raw(w, h, buf).expect("buffer sized to the image"))

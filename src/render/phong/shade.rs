@@ -14,7 +14,10 @@
 //! `falloff_power` p (E ~ 1/d^p), a light's `radius` (soft shadows from
 //! several shadow rays, `effects.rs`), the material's `fresnel` F0 (the
 //! lobe scaled by Schlick's F(H.V)/F0) and second lobe (`specular2`,
-//! `shininess2`), and the scene's `indirect_light` (a one-bounce estimate).
+//! `shininess2`), the material's `albedo_map` (the diffuse and ambient
+//! terms of a camera ray's first hit times the map at its pixel; what
+//! mirrors, glass and the one-bounce estimate see is not mapped), and the
+//! scene's `indirect_light` (a one-bounce estimate).
 //!
 //! The per-light pass over all hits is written as plain loops over arrays
 //! so that the compiler vectorises it; on CPUs with AVX2 a copy compiled for
@@ -25,8 +28,28 @@ use super::packed::{LightPack, Packed};
 use super::paths::{Paths, Via, NO_PARENT};
 use crate::math::V3;
 use crate::render::srgb::encode_slice;
+use crate::render::RenderFailure;
+use crate::scene::albedo_map::{self, AlbedoMap};
 use crate::scene::{Falloff, LightKind, Scene};
 use std::f64::consts::PI;
+use std::sync::Arc;
+
+/// Each object's albedo map, if it has one.
+pub type Maps = Vec<Option<Arc<AlbedoMap>>>;
+
+/// The albedo maps of `scene`'s objects (read once per process).
+pub fn albedo_maps(scene: &Scene) -> Result<Maps, RenderFailure> {
+    scene
+        .objects
+        .iter()
+        .map(|o| match &o.material.albedo_map {
+            Some(p) => albedo_map::get(std::path::Path::new(p))
+                .map(Some)
+                .map_err(|e| RenderFailure::new(format!("phong: {e}"))),
+            None => Ok(None),
+        })
+        .collect()
+}
 
 /// Specular terms below this fraction of their peak are skipped.
 const SPEC_CUTOFF: f64 = 1e-5;
@@ -83,7 +106,7 @@ thread_local! {
 }
 
 /// Renders `scene` from its cached hits into 8-bit sRGB RGB bytes.
-pub fn shade(paths: &Paths, packed: &Packed, scene: &Scene, out: &mut [u8]) {
+pub fn shade(paths: &Paths, packed: &Packed, scene: &Scene, maps: &Maps, out: &mut [u8]) {
     SCRATCH.with(|cell| {
         let mut guard = cell.borrow_mut();
         let Scratch { r, g, b, e, nh } = &mut *guard;
@@ -91,7 +114,7 @@ pub fn shade(paths: &Paths, packed: &Packed, scene: &Scene, out: &mut [u8]) {
             v.clear();
             v.resize(packed.n, 0.0);
         }
-        shade_into(paths, packed, scene, out, r, g, b, e, nh);
+        shade_into(paths, packed, scene, maps, out, r, g, b, e, nh);
     })
 }
 
@@ -100,6 +123,7 @@ fn shade_into(
     paths: &Paths,
     packed: &Packed,
     scene: &Scene,
+    maps: &Maps,
     out: &mut [u8],
     r: &mut [f32],
     g: &mut [f32],
@@ -109,13 +133,35 @@ fn shade_into(
 ) {
     let mats = materials(scene);
     fill_ambient(packed, &mats, r, g, b);
-    for (l, light) in scene.lights.iter().enumerate() {
-        let lamp = lamp(light);
-        if lamp.power == [0.0; 3] {
-            continue;
+    if maps.iter().all(Option::is_none) {
+        for (l, light) in scene.lights.iter().enumerate() {
+            let lamp = lamp(light);
+            if lamp.power == [0.0; 3] {
+                continue;
+            }
+            light_visibility(paths, packed, l, &lamp, e, nh);
+            add_diffuse(packed, &mats, &lamp, e, r, g, b);
+            add_specular(packed, &mats, &lamp, e, nh, r, g, b);
         }
-        light_visibility(paths, packed, l, &lamp, e, nh);
-        add_light(packed, &mats, &lamp, e, nh, r, g, b);
+    } else {
+        // The specular terms apart, so that only the diffuse ones are mapped.
+        let n = packed.n;
+        let (mut sr, mut sg, mut sb) = (vec![0f32; n], vec![0f32; n], vec![0f32; n]);
+        for (l, light) in scene.lights.iter().enumerate() {
+            let lamp = lamp(light);
+            if lamp.power == [0.0; 3] {
+                continue;
+            }
+            light_visibility(paths, packed, l, &lamp, e, nh);
+            add_diffuse(packed, &mats, &lamp, e, r, g, b);
+            add_specular(packed, &mats, &lamp, e, nh, &mut sr, &mut sg, &mut sb);
+        }
+        apply_maps(paths, packed, maps, r, g, b);
+        for i in 0..n {
+            r[i] += sr[i];
+            g[i] += sg[i];
+            b[i] += sb[i];
+        }
     }
     if let Some(k) = scene.indirect_light.filter(|&k| k > 0.0) {
         let albedo: Vec<[f32; 3]> = mats.iter().map(|m| m.diffuse).collect();
@@ -169,15 +215,13 @@ fn light_visibility(
     }
 }
 
-/// Adds one light's diffuse and specular contribution, material by material.
-#[allow(clippy::too_many_arguments)]
+/// Adds one light's diffuse contribution, material by material.
 #[inline(always)]
-fn add_light(
+fn add_diffuse(
     packed: &Packed,
     mats: &[Mat],
     lamp: &Lamp,
     e: &[f32],
-    nh: &[f32],
     r: &mut [f32],
     g: &mut [f32],
     b: &mut [f32],
@@ -195,8 +239,65 @@ fn add_light(
             k,
             &mut r[range.clone()],
             &mut g[range.clone()],
-            &mut b[range.clone()],
+            &mut b[range],
         );
+    }
+}
+
+/// Multiplies the diffuse and ambient terms of every camera ray's first
+/// hit on a mapped object by the map at the ray's pixel.
+fn apply_maps(
+    paths: &Paths,
+    packed: &Packed,
+    maps: &Maps,
+    r: &mut [f32],
+    g: &mut [f32],
+    b: &mut [f32],
+) {
+    let pixel_of: Vec<u32> = match &packed.direct_pixel {
+        Some(p) => p.clone(),
+        None => {
+            let mut v = vec![NO_PARENT; packed.n];
+            for (vi, vert) in paths.verts.iter().enumerate() {
+                if vert.parent == NO_PARENT {
+                    v[packed.packed_of[vi] as usize] = vert.pixel;
+                }
+            }
+            v
+        }
+    };
+    for grp in &packed.groups {
+        let Some(map) = &maps[grp.object as usize] else {
+            continue;
+        };
+        for i in grp.start..grp.end {
+            if pixel_of[i] == NO_PARENT {
+                continue;
+            }
+            let a = map.at(pixel_of[i] as usize);
+            r[i] *= a[0];
+            g[i] *= a[1];
+            b[i] *= a[2];
+        }
+    }
+}
+
+/// Adds one light's specular contribution, material by material.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn add_specular(
+    packed: &Packed,
+    mats: &[Mat],
+    lamp: &Lamp,
+    e: &[f32],
+    nh: &[f32],
+    r: &mut [f32],
+    g: &mut [f32],
+    b: &mut [f32],
+) {
+    for grp in &packed.groups {
+        let m = &mats[grp.object as usize];
+        let range = grp.start..grp.end;
         if m.general_specular() {
             let lobes = super::effects::Lobes {
                 spec: m.spec,

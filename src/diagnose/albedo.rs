@@ -1,0 +1,374 @@
+//! The closed-form effect `albedo_map`: a map of the diffuse colour's
+//! multipliers shared by every photograph, one value per pixel and
+//! channel, which no search could fit. A render is linear in the map
+//! (`lit` with the map at 1, `dark` with it at 0: target = dark + m (lit -
+//! dark) in linear values), so each pixel's channel is solved on its own
+//! over the photographs: the weighted median of (target - dark) / (lit -
+//! dark), weighted by lit - dark, which minimises the sum of absolute
+//! differences (the fit's metric) in linear values. Values with evidence
+//! in fewer than two photographs stay 1 and are not counted, so on a
+//! single photograph nothing is solved and the effect is no candidate.
+//!
+//! The map is solved, the model's other free parameters refitted with it
+//! in the scene, and the map solved once more against the refitted model
+//! (the better of the two kept). Its parameters for the criterion are the
+//! values solved, ln N each.
+
+use super::refit::{Model, Refine, Refits};
+use super::selection::{bic, samples};
+use super::set::{shots_of, SetModel, SetRefits};
+use super::Candidate;
+use crate::error::{Error, Result};
+use crate::fit::set::shots::Shot;
+use crate::metric::{deviation, Mask};
+use crate::raster::Image;
+use crate::render::render_one;
+use crate::scene::albedo_map::{self, AlbedoMap};
+use crate::scene::{ParamSpace, Response, Scene};
+use std::path::{Path, PathBuf};
+
+/// The effect's name in diagnosis.json.
+pub const NAME: &str = "albedo_map";
+
+/// Least linear difference between the lit and the dark render for a
+/// photograph to count as evidence at a pixel's channel (about one
+/// 8-bit step at mid-grey; below it quantisation dominates the ratio).
+const MIN_DIFFUSE: f64 = 0.01;
+
+/// Photographs with evidence a value needs.
+const MIN_PHOTOGRAPHS: usize = 2;
+
+/// Multipliers are clamped to this (a pixel lit far less than the model
+/// says, e.g. a shadow the model misses, is not a map).
+const MAX_MULTIPLIER: f64 = 8.0;
+
+/// One photograph's evidence: its target and mask, and its model rendered
+/// with the map at 1 and at 0.
+pub struct Evidence<'a> {
+    pub target: &'a Image,
+    pub mask: Option<&'a Mask>,
+    pub lit: Image,
+    pub dark: Image,
+}
+
+/// A solved map and the values it solved (the rest stayed 1).
+pub struct Solved {
+    pub map: AlbedoMap,
+    pub count: usize,
+}
+
+/// `scene` with every object's map at `path`.
+pub fn with_map(scene: &Scene, path: Option<&Path>) -> Scene {
+    let mut s = scene.clone();
+    for o in &mut s.objects {
+        o.material.albedo_map = path.map(|p| p.display().to_string());
+    }
+    s
+}
+
+/// The file of the zero map (the `dark` probe), written into `out`.
+fn zero_map(scene: &Scene, out: &Path) -> Result<PathBuf> {
+    let path = out.join("albedo_map_zero.exr");
+    let (w, h) = (scene.image.width, scene.image.height);
+    albedo_map::write(&path, AlbedoMap::uniform(w, h, 0.0))?;
+    Ok(std::path::absolute(&path).unwrap_or(path))
+}
+
+/// 8-bit sRGB code -> linear value with the camera's response undone.
+fn linear_table(response: Option<Response>) -> Vec<f64> {
+    let r = response.unwrap_or_default();
+    (0..=255u8)
+        .map(|v| {
+            let x = crate::render::srgb::decode(v);
+            ((x - r.black).max(0.0) / r.gain.max(1e-9)).powf(1.0 / r.gamma.max(1e-3))
+        })
+        .collect()
+}
+
+/// Solves the map from every photograph's evidence (linear values, the
+/// `response` undone); a value needs evidence in at least two photographs:
+/// from one, a value would match its pixel exactly whatever caused the
+/// difference (a stain or a shadow the model lacks), which no criterion
+/// over those pixels can tell from a texture (on noise-free photographs
+/// the BIC accepted such a map on one photograph). Saturated pixels (255
+/// in the target or the lit render) are no evidence.
+pub fn solve(evidence: &[Evidence], response: Option<Response>) -> Solved {
+    let (w, h) = evidence[0].target.dimensions();
+    let lin = linear_table(response);
+    let mut map = AlbedoMap::uniform(w, h, 1.0);
+    let mut count = 0;
+    let mut ratios: Vec<(f64, f64)> = Vec::with_capacity(evidence.len());
+    // Which pixels each photograph counts.
+    let inside: Vec<Vec<bool>> = evidence
+        .iter()
+        .map(|e| match e.mask {
+            Some(m) => {
+                let mut v = vec![false; (w * h) as usize];
+                for &p in m.pixels() {
+                    v[p as usize] = true;
+                }
+                v
+            }
+            None => vec![true; (w * h) as usize],
+        })
+        .collect();
+    for p in 0..(w * h) as usize {
+        for c in 0..3 {
+            ratios.clear();
+            let i = 3 * p + c;
+            for (e, inside) in evidence.iter().zip(&inside) {
+                if !inside[p] {
+                    continue;
+                }
+                let (t, l, d) = (e.target.as_raw()[i], e.lit.as_raw()[i], e.dark.as_raw()[i]);
+                let diffuse = lin[l as usize] - lin[d as usize];
+                if t == 255 || l == 255 || diffuse < MIN_DIFFUSE {
+                    continue;
+                }
+                ratios.push(((lin[t as usize] - lin[d as usize]) / diffuse, diffuse));
+            }
+            if ratios.len() >= MIN_PHOTOGRAPHS {
+                map.values[i] = weighted_median(&mut ratios).clamp(0.0, MAX_MULTIPLIER) as f32;
+                count += 1;
+            }
+        }
+    }
+    Solved { map, count }
+}
+
+/// The value minimising the weighted sum of absolute deviations.
+fn weighted_median(v: &mut [(f64, f64)]) -> f64 {
+    v.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let half = v.iter().map(|x| x.1).sum::<f64>() / 2.0;
+    let mut acc = 0.0;
+    for &(x, w) in v.iter() {
+        acc += w;
+        if acc >= half {
+            return x;
+        }
+    }
+    v.last().map_or(1.0, |x| x.0)
+}
+
+/// The probes of `scene`: its maps removed (at 1), and every map at 0.
+fn probes(scene: &Scene, zero: &Path) -> (Scene, Scene) {
+    (with_map(scene, None), with_map(scene, Some(zero)))
+}
+
+/// The map file of round `round` (`first`: before the refit).
+fn map_path(out: &Path, round: usize, first: bool) -> PathBuf {
+    let name = if first {
+        format!("albedo_map_round{round}_first.exr")
+    } else {
+        format!("albedo_map_round{round}.exr")
+    };
+    let p = out.join(name);
+    std::path::absolute(&p).unwrap_or(p)
+}
+
+/// Removes the map file a model no longer names.
+fn discard(path: &Path) {
+    let _ = std::fs::remove_file(path);
+}
+
+/// One photograph: the map solved for `scene`, written to `path`; None
+/// when no value could be solved.
+fn solve_one(
+    fits: &mut Refits,
+    scene: &Scene,
+    path: &Path,
+    out: &Path,
+) -> Result<Option<(Scene, usize)>> {
+    let zero = zero_map(scene, out)?;
+    let (lit, dark) = probes(scene, &zero);
+    let renderer = fits.renderer();
+    fits.renders += 2;
+    let evidence = [Evidence {
+        target: &fits.inputs.target,
+        mask: fits.inputs.mask.as_ref(),
+        lit: render_one(renderer, &lit, 0)?,
+        dark: render_one(renderer, &dark, 0)?,
+    }];
+    discard(&zero);
+    let solved = solve(&evidence, scene.camera.response);
+    if solved.count == 0 {
+        return Ok(None);
+    }
+    albedo_map::write(path, solved.map)?;
+    Ok(Some((with_map(scene, Some(path)), solved.count)))
+}
+
+/// The candidate `albedo_map` on one photograph: solved, the others
+/// refitted, solved again; None when nothing could be solved.
+pub fn candidate(
+    fits: &mut Refits,
+    model: &Model,
+    round: usize,
+    out: &Path,
+) -> Result<Option<(Candidate, Model)>> {
+    let (first, second) = (map_path(out, round, true), map_path(out, round, false));
+    let Some((scene, count1)) = solve_one(fits, &model.scene, &first, out)? else {
+        return Ok(None);
+    };
+    let config = fits.config;
+    let refit = fits.run(
+        &scene,
+        None,
+        Refine::close(config, config.refine_generations),
+    )?;
+    let mut best = (refit, count1, first.clone());
+    if let Some((again, count2)) = solve_one(fits, &best.0.scene, &second, out)? {
+        fits.renders += 1;
+        let image = render_one(fits.renderer(), &again, 0)?;
+        let m = Model::new(again, image, fits.inputs);
+        if m.sad < best.0.sad {
+            best = (m, count2, second.clone());
+        }
+    }
+    discard(if best.2 == first { &second } else { &first });
+    let (fitted, count, _) = best;
+    let inputs = fits.inputs;
+    let n = samples(&inputs.target, inputs.mask.as_ref());
+    let k0 = ParamSpace::from_scene(&model.scene).dim();
+    let c = Candidate {
+        effect: NAME.into(),
+        evidence: 0.0,
+        deviation_after: Some(deviation(
+            &inputs.target,
+            &fitted.image,
+            inputs.mask.as_ref(),
+        )),
+        round,
+        delta_bic: Some(bic(fitted.sad, n, k0 + count) - bic(model.sad, n, k0)),
+        gain: Some(1.0 - fitted.sad / model.sad.max(1e-9)),
+        added_params: count,
+        accepted: false,
+        refit: "closed form, then warm".into(),
+    };
+    Ok(Some((c, fitted)))
+}
+
+/// A set: the map solved for `scene` with each photograph's `own`
+/// values, written to `path`; None when no value could be solved.
+fn solve_set(
+    fits: &mut SetRefits,
+    scene: &Scene,
+    own: &[super::set::Params],
+    path: &Path,
+) -> Result<Option<(Scene, usize)>> {
+    let zero = zero_map(scene, fits.out)?;
+    let (lit, dark) = probes(scene, &zero);
+    let inputs = fits.inputs;
+    let rendered = |fits: &mut SetRefits, s: &Scene| -> Result<Vec<Image>> {
+        let shots: Vec<Shot> = shots_of(s, inputs, own)?;
+        fits.render(&shots)?
+            .map(|(images, _)| images)
+            .ok_or_else(|| Error::Run("albedo_map: a render of the set failed".into()))
+    };
+    let lit = rendered(fits, &lit)?;
+    let dark = rendered(fits, &dark)?;
+    discard(&zero);
+    let evidence: Vec<Evidence> = inputs
+        .shots
+        .iter()
+        .zip(lit.into_iter().zip(dark))
+        .map(|(s, (lit, dark))| Evidence {
+            target: &s.target.image,
+            mask: s.target.mask.as_ref(),
+            lit,
+            dark,
+        })
+        .collect();
+    let solved = solve(&evidence, scene.camera.response);
+    if solved.count == 0 {
+        return Ok(None);
+    }
+    albedo_map::write(path, solved.map)?;
+    Ok(Some((with_map(scene, Some(path)), solved.count)))
+}
+
+/// The model of a set with `albedo_map`: solved, the others refitted over
+/// the set, solved again; the model and the values solved (None: nothing
+/// could be solved).
+pub fn set_model(
+    fits: &mut SetRefits,
+    model: &SetModel,
+    round: usize,
+) -> Result<Option<(SetModel, usize)>> {
+    let out = fits.out;
+    let (first, second) = (map_path(out, round, true), map_path(out, round, false));
+    let Some((scene, count1)) = solve_set(fits, &model.scene, &model.own, &first)? else {
+        return Ok(None);
+    };
+    let refit = fits.run(&scene, &model.own)?;
+    let mut best = (refit, count1, first.clone());
+    if let Some((again, count2)) = solve_set(fits, &best.0.scene, &best.0.own, &second)? {
+        let shots = shots_of(&again, fits.inputs, &best.0.own)?;
+        if let Some((images, sad)) = fits.render(&shots)? {
+            if sad < best.0.sad {
+                let own = best.0.own.clone();
+                best = (
+                    SetModel {
+                        scene: again,
+                        own,
+                        images,
+                        sad,
+                    },
+                    count2,
+                    second.clone(),
+                );
+            }
+        }
+    }
+    discard(if best.2 == first { &second } else { &first });
+    Ok(Some((best.0, best.1)))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_weighted_median_follows_the_weights() {
+        let mut v = [(1.0, 1.0), (5.0, 3.0), (2.0, 1.0)];
+        assert_eq!(weighted_median(&mut v), 5.0);
+        let mut v = [(1.0, 3.0), (5.0, 1.0), (2.0, 1.0)];
+        assert_eq!(weighted_median(&mut v), 1.0);
+    }
+
+    #[test]
+    fn a_map_planted_in_linear_values_is_solved_where_there_is_evidence() {
+        // Two photographs: lit and dark renders, a target = dark + m (lit -
+        // dark) with m = 0.5 at pixel 0, 1 elsewhere; pixel 3 unlit.
+        let (w, h) = (2, 2);
+        let code = |x: f64| crate::render::srgb::encode(x);
+        let make = |f: &dyn Fn(usize) -> f64| {
+            Image::from_fn(w, h, |x, y| {
+                let v = code(f((y * w + x) as usize));
+                image::Rgb([v, v, v])
+            })
+        };
+        let lit_v = |p: usize| if p == 3 { 0.0_f64 } else { 0.6 };
+        let dark_v = |_: usize| 0.05_f64;
+        let m = |p: usize| if p == 0 { 0.5_f64 } else { 1.0 };
+        let mut evidence = Vec::new();
+        let target = make(&|p| dark_v(p) + m(p) * (lit_v(p) - dark_v(p)).max(0.0));
+        for _ in 0..2 {
+            evidence.push((make(&lit_v), make(&dark_v)));
+        }
+        let ev: Vec<Evidence> = evidence
+            .into_iter()
+            .map(|(lit, dark)| Evidence {
+                target: &target,
+                mask: None,
+                lit,
+                dark,
+            })
+            .collect();
+        let s = solve(&ev, None);
+        assert_eq!(s.count, 9, "pixels 0-2, three channels each");
+        assert!((s.map.at(0)[0] - 0.5).abs() < 0.02, "{:?}", s.map.at(0));
+        assert!((s.map.at(1)[1] - 1.0).abs() < 0.02);
+        assert_eq!(s.map.at(3), [1.0; 3], "no evidence: left at 1");
+    }
+}
