@@ -59,10 +59,14 @@ fn fit(d: &Path, out: &str, extra: &[&str]) -> std::process::Output {
         out,
         "-q",
     ];
+    // The paper's strategy: these tests are about run directories, and
+    // they count its generations and read its population in checkpoints
+    // (the default hybrid may end a converged run early).
     for (flag, value) in [
         ("--generations", "6"),
         ("--population", "10"),
         ("--seed", "2"),
+        ("--strategy", "rand1bin"),
     ] {
         if !extra.contains(&flag) {
             args.extend([flag, value]);
