@@ -171,6 +171,7 @@ fn the_joint_step_lowers_what_a_short_block_descent_leaves() {
         "8",
         "--rounds",
         "1",
+        "--joint",
         "--quiet",
     ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));

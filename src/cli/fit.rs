@@ -92,6 +92,10 @@ pub struct FitArgs {
     /// per-shot blocks at most.
     #[arg(long, default_value_t = 4, value_parser = super::positive_count)]
     rounds: usize,
+    /// A set of photographs (--shots): end with one Levenberg–Marquardt
+    /// block over the shared and every photograph's own values at once.
+    #[arg(long)]
+    joint: bool,
     /// No progress output.
     #[arg(long, short)]
     quiet: bool,
@@ -178,6 +182,7 @@ fn run_set(a: &FitArgs, scene: &Scene, shots: &[crate::fit::set::shots::Shot]) -
         fit: config,
         rounds: a.rounds,
         warm: false,
+        joint: a.joint,
     };
     let mut progress = Progress::new(a.quiet);
     let outcome = fit::set::run(

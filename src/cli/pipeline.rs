@@ -9,12 +9,12 @@ use super::fit::interrupt_flag;
 use super::progress::Progress;
 use super::search::{Search, Stage1, Stage2};
 use crate::error::{Error, Result};
-use crate::fit::{GenerationReport, Observer};
+use crate::fit::{FitConfig, GenerationReport, Observer};
 use crate::pipeline::{self, Iteration, MappedBudget, PipelineConfig, Stage2Method, StageObserver};
 use crate::render::{from_spec_with, RenderOptions, Renderer};
 use crate::report::{self, ReportOptions};
 use crate::scene::memory::Population;
-use crate::scene::{load_with, Override};
+use crate::scene::{load_with, Override, Scene};
 use clap::Args;
 use std::path::{Path, PathBuf};
 
@@ -108,20 +108,7 @@ pub fn run(a: PipelineArgs) -> Result<()> {
     let interrupt = interrupt_flag();
     let mut stage1 = a.s1.config(r1.default_jobs())?;
     let mut stage2 = a.s2.config(r2.default_jobs())?;
-    let file = a.inputs.scene.display().to_string();
-    let (w, h) = (scene.image.width, scene.image.height);
-    let avail = crate::scene::memory::available();
-    for (c, option) in [
-        (&stage1, "--stage1-population"),
-        (&stage2, "--stage2-population"),
-    ] {
-        let pop = Population {
-            option,
-            size: c.de.population,
-            copies: 1,
-        };
-        crate::scene::memory::check_fit(avail, &file, (w, h), pop, c.jobs)?;
-    }
+    check_memory(&a, &scene, &stage1, &stage2)?;
     stage1.interrupt = Some(interrupt.clone());
     stage2.interrupt = Some(interrupt);
     let config = PipelineConfig {
@@ -180,6 +167,23 @@ pub fn run(a: PipelineArgs) -> Result<()> {
             Some(p) => println!("report: {}", p.display()),
             None => println!("results in {}", a.output.display()),
         }
+    }
+    Ok(())
+}
+
+/// Refuses stages whose populations would not fit in memory, naming the
+/// stage's option.
+fn check_memory(a: &PipelineArgs, scene: &Scene, s1: &FitConfig, s2: &FitConfig) -> Result<()> {
+    let file = a.inputs.scene.display().to_string();
+    let size = (scene.image.width, scene.image.height);
+    let avail = crate::scene::memory::available();
+    for (c, option) in [(s1, "--stage1-population"), (s2, "--stage2-population")] {
+        let pop = Population {
+            option,
+            size: c.de.population,
+            copies: 1,
+        };
+        crate::scene::memory::check_fit(avail, &file, size, pop, c.jobs)?;
     }
     Ok(())
 }

@@ -275,6 +275,7 @@ impl SetRefits<'_> {
             },
             rounds: 2,
             warm: true,
+            joint: false,
         };
         let out = setfit::run_in(scene, &shots, self.renderer, &config, None, &mut ())?;
         self.renders += out.result.evaluations + shots.len();

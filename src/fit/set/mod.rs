@@ -14,9 +14,10 @@
 //!    (`problem`);
 //!
 //! and again 1, 2, … until a round improves the deviation over the whole
-//! set by less than 1 %, or the round budget is spent; then one joint
-//! block moves every coordinate at once by Levenberg–Marquardt (`joint`),
-//! which follows the valleys where shared and per-shot values trade.
+//! set by less than 1 %, or the round budget is spent; then, with
+//! `--joint`, one joint block moves every coordinate at once by
+//! Levenberg–Marquardt (`joint`), which follows the valleys where shared
+//! and per-shot values trade.
 //! Later blocks start around the current values. The state is saved after every block
 //! (`state`), so `--resume` continues from the last finished block.
 
@@ -53,6 +54,10 @@ pub struct SetConfig {
     /// skip the first per-shot block and start every block around the
     /// current values.
     pub warm: bool,
+    /// End with the joint block (`--joint`). Off by default: on a
+    /// generated set missing a second light it fitted the wrong model
+    /// better, and the diagnosis then chose area_light (docs/sets.md).
+    pub joint: bool,
 }
 
 /// Relative improvement of a round below which the blocks stop.
@@ -108,7 +113,7 @@ pub fn run_in(
         (Some(d), Mode::Resume) => SetState::resume(d, scene, shots, renderer, config, &space)?,
         _ => SetState::start(scene, shots, renderer, config, &space),
     };
-    let plan = plan(&space, shots, config.rounds, config.warm);
+    let plan = plan(&space, shots, config);
     let started = Instant::now();
     let before = state.seconds;
     let mut cleared = config.fit.mode != Mode::Overwrite;
@@ -156,7 +161,8 @@ enum Block {
 /// The blocks in order: own, shared, own, shared, own, … (`rounds` shared
 /// blocks), then the joint block; a set with only one kind of parameter
 /// has only that block.
-fn plan(space: &ParamSpace, shots: &[Shot], rounds: usize, warm: bool) -> Vec<Block> {
+fn plan(space: &ParamSpace, shots: &[Shot], config: &SetConfig) -> Vec<Block> {
+    let (rounds, warm, joint) = (config.rounds, config.warm, config.joint);
     let has_own = shots.iter().any(|s| !s.own_space(space).is_empty());
     let has_shared = !space.shared().is_empty();
     match (has_own, has_shared) {
@@ -165,7 +171,9 @@ fn plan(space: &ParamSpace, shots: &[Shot], rounds: usize, warm: bool) -> Vec<Bl
             for _ in 0..rounds.max(1) {
                 v.extend([Block::Shared, Block::Own]);
             }
-            v.push(Block::Joint);
+            if joint {
+                v.push(Block::Joint);
+            }
             v
         }
         (true, false) => vec![Block::Own],
