@@ -15,12 +15,11 @@
 //! values solved, ln N each.
 
 use super::refit::{Model, Refine, Refits};
-use super::selection::{bic, samples};
 use super::set::{shots_of, SetModel, SetRefits};
 use super::Candidate;
 use crate::error::{Error, Result};
 use crate::fit::set::shots::Shot;
-use crate::metric::{deviation, Mask};
+use crate::metric::Mask;
 use crate::raster::Image;
 use crate::render::render_one;
 use crate::scene::albedo_map::{self, AlbedoMap};
@@ -227,24 +226,9 @@ pub fn candidate(
     }
     discard(if best.2 == first { &second } else { &first });
     let (fitted, count, _) = best;
-    let inputs = fits.inputs;
-    let n = samples(&inputs.target, inputs.mask.as_ref());
     let k0 = ParamSpace::from_scene(&model.scene).dim();
-    let c = Candidate {
-        effect: NAME.into(),
-        evidence: 0.0,
-        deviation_after: Some(deviation(
-            &inputs.target,
-            &fitted.image,
-            inputs.mask.as_ref(),
-        )),
-        round,
-        delta_bic: Some(bic(fitted.sad, n, k0 + count) - bic(model.sad, n, k0)),
-        gain: Some(1.0 - fitted.sad / model.sad.max(1e-9)),
-        added_params: count,
-        accepted: false,
-        refit: "closed form, then warm".into(),
-    };
+    let refit = "closed form, then warm";
+    let c = Candidate::scored(NAME, round, fits.inputs, model, &fitted, k0, count, refit);
     Ok(Some((c, fitted)))
 }
 

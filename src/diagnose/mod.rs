@@ -65,6 +65,40 @@ pub struct Candidate {
     pub refit: String,
 }
 
+impl Candidate {
+    /// The candidate of an effect whose refit of `model` (with `k0` free
+    /// values) gave `fitted` with `added` more: its deviation, BIC change
+    /// and gain on one photograph; evidence left at 0 for the caller.
+    #[allow(clippy::too_many_arguments)]
+    fn scored(
+        effect: &str,
+        round: usize,
+        inputs: &Inputs,
+        model: &Model,
+        fitted: &Model,
+        k0: usize,
+        added: usize,
+        refit: &str,
+    ) -> Candidate {
+        let n = samples(&inputs.target, inputs.mask.as_ref());
+        Candidate {
+            effect: effect.to_string(),
+            evidence: 0.0,
+            deviation_after: Some(deviation(
+                &inputs.target,
+                &fitted.image,
+                inputs.mask.as_ref(),
+            )),
+            round,
+            delta_bic: Some(bic(fitted.sad, n, k0 + added) - bic(model.sad, n, k0)),
+            gain: Some(1.0 - fitted.sad / model.sad.max(1e-9)),
+            added_params: added,
+            accepted: false,
+            refit: refit.into(),
+        }
+    }
+}
+
 /// diagnosis.json.
 #[derive(Clone, Debug, Serialize)]
 pub struct Diagnosis {
@@ -219,22 +253,6 @@ fn try_effect(
         }
         fitted = fitted.better(again);
     }
-    let inputs = fits.inputs;
-    let n = samples(&inputs.target, inputs.mask.as_ref());
-    let candidate = Candidate {
-        effect: name.to_string(),
-        evidence: 0.0,
-        deviation_after: Some(deviation(
-            &inputs.target,
-            &fitted.image,
-            inputs.mask.as_ref(),
-        )),
-        round,
-        delta_bic: Some(bic(fitted.sad, n, k0 + added) - bic(model.sad, n, k0)),
-        gain: Some(1.0 - fitted.sad / model.sad.max(1e-9)),
-        added_params: added,
-        accepted: false,
-        refit: refit.into(),
-    };
+    let candidate = Candidate::scored(name, round, fits.inputs, model, &fitted, k0, added, refit);
     Ok(Some((candidate, fitted)))
 }

@@ -314,23 +314,7 @@ impl Local {
     /// The damped step from `x`, with coordinates on a face whose step
     /// would leave the cube held fixed; None when it does not move.
     fn next_trial(&self) -> Option<Vec<f64>> {
-        let normal = self.normal.as_ref()?;
-        let mut free = vec![true; self.x.len()];
-        let mut step = lm::damped_step(normal, self.lambda, &free)?;
-        let blocked = |x: f64, s: f64| (x <= 0.0 && s < 0.0) || (x >= 1.0 && s > 0.0);
-        if self.x.iter().zip(&step).any(|(&x, &s)| blocked(x, s)) {
-            for (j, f) in free.iter_mut().enumerate() {
-                *f = !blocked(self.x[j], step[j]);
-            }
-            step = lm::damped_step(normal, self.lambda, &free)?;
-        }
-        let trial: Vec<f64> = self
-            .x
-            .iter()
-            .zip(&step)
-            .map(|(&x, &s)| (x + s).clamp(0.0, 1.0))
-            .collect();
-        (trial != self.x).then_some(trial)
+        lm::bounded_trial(self.normal.as_ref()?, self.lambda, &self.x)
     }
 }
 
