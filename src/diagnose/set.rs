@@ -172,34 +172,28 @@ pub(super) struct SetRefits<'a> {
 }
 
 impl SetRefits<'_> {
-    /// Renders `scene` with every photograph's `own` values: the images
-    /// and the set's sum of absolute differences (None: a render failed).
+    /// Renders every photograph's scene in `shots`: the images and the
+    /// set's sum of absolute differences (None: a render failed).
     pub(super) fn render(&mut self, shots: &[Shot]) -> Result<Option<(Vec<Image>, f64)>> {
-        let scenes: Vec<Scene> = shots.iter().map(|s| s.scene.clone()).collect();
-        let space = ParamSpace::from_scene(&scenes[0]);
-        let mut session = self
-            .renderer
-            .session(&scenes[0], &space, self.config.jobs)?;
-        self.renders += scenes.len();
-        let mut images = Vec::with_capacity(scenes.len());
-        let mut total = 0.0;
-        for (r, s) in session.render_batch(&scenes, 0).into_iter().zip(shots) {
-            match r {
-                Ok(img) if img.dimensions() == s.target.image.dimensions() => {
-                    total += sad(&s.target.image, &img, s.target.mask.as_ref());
-                    images.push(img);
-                }
-                _ => return Ok(None),
-            }
-        }
-        Ok(Some((images, total)))
+        let scored = score(self.renderer, shots, self.config.jobs)?;
+        self.renders += shots.len();
+        Ok(scored
+            .into_iter()
+            .collect::<std::result::Result<Vec<_>, _>>()
+            .ok()
+            .map(|v| {
+                let sad = v.iter().map(|x| x.1).sum();
+                (v.into_iter().map(|x| x.0).collect(), sad)
+            }))
     }
 
     /// The best of an extension's starts on the set (the extended scene
     /// included): each start's shared values with every photograph's own
-    /// values, and again with its level matched to the photographs' (every
-    /// free light intensity scaled, per-shot ones included, which changes
-    /// the photographs' own values). The start's scene and own values.
+    /// values, and again with its level matched to the photographs': the
+    /// shared free intensities scaled by the set's pooled ratio, and each
+    /// photograph's own free intensities by its own ratio (a new gamma
+    /// changes each photograph's level by its own amount). The start's
+    /// scene and own values.
     fn best_start(
         &mut self,
         ext: &effects::Extension,
@@ -209,17 +203,22 @@ impl SetRefits<'_> {
             return Ok((ext.scene.clone(), own.to_vec()));
         }
         let inputs = self.inputs;
-        let pooled_level = |images: &[&Image]| {
-            let (mut sum, mut n) = (0.0, 0.0);
-            for (img, s) in images.iter().zip(&inputs.shots) {
-                let w = crate::fit::set::counted(&s.target) as f64;
-                sum += w * super::starts::level(img, s.target.mask.as_ref());
-                n += w;
-            }
-            sum / n.max(1.0)
+        let levels = |images: &[&Image]| -> Vec<(f64, f64)> {
+            images
+                .iter()
+                .zip(&inputs.shots)
+                .map(|(img, s)| {
+                    let w = crate::fit::set::counted(&s.target) as f64;
+                    (w, super::starts::level(img, s.target.mask.as_ref()))
+                })
+                .collect()
+        };
+        let pooled = |l: &[(f64, f64)]| {
+            let n: f64 = l.iter().map(|x| x.0).sum();
+            l.iter().map(|x| x.0 * x.1).sum::<f64>() / n.max(1.0)
         };
         let targets: Vec<&Image> = inputs.shots.iter().map(|s| &s.target.image).collect();
-        let want = pooled_level(&targets);
+        let want = levels(&targets);
         let mut best = (f64::INFINITY, ext.scene.clone(), own.to_vec());
         for start in std::iter::once(&ext.scene).chain(&ext.starts) {
             let shots = shots_of(start, inputs, own)?;
@@ -229,16 +228,24 @@ impl SetRefits<'_> {
             if d < best.0 {
                 best = (d, start.clone(), own.to_vec());
             }
-            let have = pooled_level(&images.iter().collect::<Vec<_>>());
-            if have <= 0.0 {
+            let have = levels(&images.iter().collect::<Vec<_>>());
+            if pooled(&have) <= 0.0 {
                 continue;
             }
+            let shared =
+                effects::edit::match_level_where(start, pooled(&want) / pooled(&have), |f| {
+                    !f.per_shot
+                });
             let space = ParamSpace::from_scene(start);
-            let matched: Vec<Shot> = shots
-                .iter()
-                .map(|s| Shot {
-                    scene: effects::edit::match_level(&s.scene, want / have),
-                    ..s.clone()
+            let matched: Vec<Shot> = shots_of(&shared, inputs, own)?
+                .into_iter()
+                .zip(want.iter().zip(&have))
+                .map(|(s, (w, h))| {
+                    let k = if h.1 > 0.0 { w.1 / h.1 } else { 1.0 };
+                    let scene = effects::edit::match_level_where(&s.scene, k, |f| {
+                        f.per_shot && !s.entry.set.contains_key(&f.param)
+                    });
+                    Shot { scene, ..s }
                 })
                 .collect();
             if let Some((_, d)) = self.render(&matched)? {
@@ -247,7 +254,7 @@ impl SetRefits<'_> {
                         .iter()
                         .map(|s| s.own_space(&space).json_values(&s.scene))
                         .collect();
-                    best = (d, start.clone(), own_now);
+                    best = (d, shared, own_now);
                 }
             }
         }
@@ -292,29 +299,43 @@ impl SetRefits<'_> {
     }
 }
 
+/// Each photograph's scene in `shots` rendered once (in one session) and
+/// scored against it: its image and sum of absolute differences, or why
+/// it has none.
+fn score(
+    renderer: &dyn Renderer,
+    shots: &[Shot],
+    jobs: usize,
+) -> Result<Vec<std::result::Result<(Image, f64), String>>> {
+    let scenes: Vec<Scene> = shots.iter().map(|s| s.scene.clone()).collect();
+    let space = ParamSpace::from_scene(&scenes[0]);
+    let images = setfit::renders::render_shots(renderer, &scenes, shots, &space, jobs, 0)?;
+    Ok(images
+        .into_iter()
+        .zip(shots)
+        .map(|(img, s)| {
+            img.map(|img| {
+                let d = sad(&s.target.image, &img, s.target.mask.as_ref());
+                (img, d)
+            })
+        })
+        .collect())
+}
+
 /// The renders of the fitted model as it stands.
 fn initial(renderer: &dyn Renderer, inputs: &SetInputs, jobs: usize) -> Result<SetModel> {
     let shots = shots_of(&inputs.scene, inputs, &inputs.own)?;
-    let scenes: Vec<Scene> = shots.iter().map(|s| s.scene.clone()).collect();
-    let mut session = renderer.session(&scenes[0], &ParamSpace::from_scene(&scenes[0]), jobs)?;
-    let mut images = Vec::with_capacity(scenes.len());
+    let mut images = Vec::with_capacity(shots.len());
     let mut total = 0.0;
-    for (r, s) in session.render_batch(&scenes, 0).into_iter().zip(&shots) {
-        let img = r.map_err(|f| {
+    for (r, s) in score(renderer, &shots, jobs)?.into_iter().zip(&shots) {
+        let (img, d) = r.map_err(|why| {
             Error::Run(format!(
-                "{}: render of shot {} failed: {f}",
+                "{}: the render of shot {} {why}",
                 renderer.name(),
                 s.name
             ))
         })?;
-        if img.dimensions() != s.target.image.dimensions() {
-            return Err(Error::Run(format!(
-                "{}: the render of shot {} has the wrong size",
-                renderer.name(),
-                s.name
-            )));
-        }
-        total += sad(&s.target.image, &img, s.target.mask.as_ref());
+        total += d;
         images.push(img);
     }
     Ok(SetModel {
@@ -393,6 +414,7 @@ pub fn run(inputs: &SetInputs, out: &Path, config: &DiagnoseConfig) -> Result<Se
         diagnosis,
         shots_after,
     };
+    super::albedo::prune(out, &model.scene);
     super::report::write_set(
         out,
         &d,

@@ -169,6 +169,12 @@ pub fn closer(scene: &Scene, scale: f64) -> Scene {
 /// clamped to its bounds: a start's level is matched to the target's before
 /// it is compared.
 pub fn match_level(scene: &Scene, k: f64) -> Scene {
+    match_level_where(scene, k, |_| true)
+}
+
+/// [`match_level`] over the free intensities whose entries `which` picks
+/// (a set's per-shot or shared ones).
+pub fn match_level_where(scene: &Scene, k: f64, which: impl Fn(&FreeParam) -> bool) -> Scene {
     let gamma = scene.camera.response.map_or(1.0, |r| r.gamma);
     let factor = k.max(0.0).powf(1.0 / gamma.max(1e-3));
     let mut s = scene.clone();
@@ -176,7 +182,35 @@ pub fn match_level(scene: &Scene, k: f64) -> Scene {
         let Some(f) = free_entry(scene, Field::Light(i, LightField::Intensity)) else {
             continue;
         };
-        l.intensity = (l.intensity * factor).clamp(f.min.at(0), f.max.at(0));
+        if which(f) {
+            l.intensity = (l.intensity * factor).clamp(f.min.at(0), f.max.at(0));
+        }
     }
     s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn level_matching_scales_only_the_intensities_picked_through_the_gamma() {
+        let mut scene = crate::scene::test_scene::ball(
+            r#""color": [0.5, 0.5, 0.5]"#,
+            r#"{"param": "lights.key.intensity", "min": 1, "max": 50, "per_shot": true}"#,
+        );
+        // Not picked: unchanged.
+        let same = match_level_where(&scene, 4.0, |f| !f.per_shot);
+        assert_eq!(same.lights[0].intensity, 10.0);
+        // Picked: the linear level times 4 is the intensity times 4^(1/γ).
+        scene.camera.response = Some(crate::scene::Response {
+            gamma: 2.0,
+            ..Default::default()
+        });
+        let matched = match_level_where(&scene, 4.0, |f| f.per_shot);
+        assert!((matched.lights[0].intensity - 20.0).abs() < 1e-9);
+        // Clamped to the entry's bounds.
+        let capped = match_level(&scene, 100.0);
+        assert_eq!(capped.lights[0].intensity, 50.0);
+    }
 }

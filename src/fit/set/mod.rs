@@ -24,6 +24,7 @@
 mod joint;
 mod outcome;
 mod problem;
+pub mod renders;
 pub mod shots;
 mod state;
 

@@ -109,25 +109,24 @@ fn render_final(
     space: &ParamSpace,
     state: &SetState,
 ) -> Result<Vec<ShotOutcome>> {
-    let mut session = renderer.session(&scenes[0], &varying(space, shots), config.fit.jobs)?;
-    let images = session.render_batch(&scenes, render_seed(config.fit.de.seed, state.generations));
+    let images = super::renders::render_shots(
+        renderer,
+        &scenes,
+        shots,
+        &varying(space, shots),
+        config.fit.jobs,
+        render_seed(config.fit.de.seed, state.generations),
+    )?;
     let mut outs = Vec::with_capacity(shots.len());
     for ((shot, scene), img) in shots.iter().zip(scenes).zip(images) {
-        let image = img.map_err(|f| {
+        let image = img.map_err(|why| {
             Error::Run(format!(
-                "{}: the final render of shot {} failed: {f}",
+                "{}: the final render of shot {} {why}",
                 renderer.name(),
                 shot.name
             ))
         })?;
         let t = &shot.target;
-        if image.dimensions() != t.image.dimensions() {
-            return Err(Error::Run(format!(
-                "{}: the final render of shot {} has the wrong size",
-                renderer.name(),
-                shot.name
-            )));
-        }
         let own = shot.own_space(space);
         outs.push(ShotOutcome {
             result: ShotResult {
