@@ -501,6 +501,15 @@ fn cases() -> Vec<Case> {
         "--target".into(),
         "larger than 1024 MiB".into(),
     ];
+    // Options of a set fit without a set: refused, not silently ignored.
+    for flag in [&["--joint"][..], &["--rounds", "2"][..]] {
+        c.push(fit_case(
+            &format!("{} without --shots", flag[0]),
+            plain.clone(),
+            flag,
+            &[flag[0], "--shots"],
+        ));
+    }
     c.push(fit_case(
         "/dev/zero as mask",
         plain.clone(),

@@ -89,9 +89,9 @@ pub struct FitArgs {
     #[arg(long, value_delimiter = ',', value_name = "NAMES")]
     nuisance: Vec<crate::scene::Nuisance>,
     /// A set of photographs (--shots): alternations of the shared and the
-    /// per-shot blocks at most.
-    #[arg(long, default_value_t = 4, value_parser = super::positive_count)]
-    rounds: usize,
+    /// per-shot blocks at most [default: 4].
+    #[arg(long, value_parser = super::positive_count)]
+    rounds: Option<usize>,
     /// A set of photographs (--shots): end with one Levenberg–Marquardt
     /// block over the shared and every photograph's own values at once.
     #[arg(long)]
@@ -102,6 +102,12 @@ pub struct FitArgs {
 }
 
 pub fn run(a: FitArgs) -> Result<()> {
+    if a.inputs.shots.is_none() && (a.joint || a.rounds.is_some()) {
+        let flag = if a.joint { "--joint" } else { "--rounds" };
+        return Err(Error::Usage(format!(
+            "{flag}: applies to a set of photographs; give --shots SHOTS.json"
+        )));
+    }
     let mut scene = load_with(&a.inputs.scene, &a.set)?;
     crate::scene::nuisance::add(&mut scene, &a.nuisance);
     if let Some(shots) = &a.inputs.shots {
@@ -180,7 +186,7 @@ fn run_set(a: &FitArgs, scene: &Scene, shots: &[crate::fit::set::shots::Shot]) -
     config.interrupt = Some(interrupt_flag());
     let set = fit::set::SetConfig {
         fit: config,
-        rounds: a.rounds,
+        rounds: a.rounds.unwrap_or(4),
         warm: false,
         joint: a.joint,
     };
