@@ -182,6 +182,24 @@ fn a_planted_map_is_accepted_first_on_a_set_and_frees_the_lights() {
         Path::new(&map).starts_with(dir.path().join("diag").canonicalize().unwrap())
             || Path::new(&map).starts_with(dir.path().join("diag"))
     );
+    // ... and it is the only map left there.
+    assert!(Path::new(&map).exists(), "{map} missing");
+    assert_eq!(
+        maps_in(&dir.path().join("diag")).len(),
+        1,
+        "{:?}",
+        maps_in(&dir.path().join("diag"))
+    );
+}
+
+/// The albedo-map files in a diagnosis directory.
+fn maps_in(dir: &Path) -> Vec<String> {
+    std::fs::read_dir(dir)
+        .unwrap()
+        .flatten()
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .filter(|n| n.ends_with(".exr"))
+        .collect()
 }
 
 #[test]
@@ -194,6 +212,12 @@ fn noise_only_and_a_single_photograph_do_not_accept_the_map() {
     assert!(
         tried.iter().any(|c| c["effect"] == "albedo_map"),
         "not tried"
+    );
+    // A map that was not accepted does not stay behind as if it were a result.
+    assert!(
+        maps_in(&dir.path().join("diag")).is_empty(),
+        "{:?}",
+        maps_in(&dir.path().join("diag"))
     );
 
     let one = tempfile::tempdir().unwrap();

@@ -170,6 +170,31 @@ fn discard(path: &Path) {
     let _ = std::fs::remove_file(path);
 }
 
+/// Removes from `out` every map file the diagnosis wrote that `kept` (its
+/// final model) does not name: the maps of rejected candidates and the
+/// probe, which would otherwise read as results.
+pub fn prune(out: &Path, kept: &Scene) {
+    let named: Vec<PathBuf> = kept
+        .objects
+        .iter()
+        .filter_map(|o| o.material.albedo_map.as_deref().map(PathBuf::from))
+        .collect();
+    let Ok(entries) = std::fs::read_dir(out) else {
+        return;
+    };
+    for e in entries.flatten() {
+        let name = e.file_name().to_string_lossy().into_owned();
+        if !(name.starts_with("albedo_map_") && name.ends_with(".exr")) {
+            continue;
+        }
+        let path = e.path();
+        let absolute = std::path::absolute(&path).unwrap_or(path.clone());
+        if !named.iter().any(|n| n == &absolute || n == &path) {
+            discard(&path);
+        }
+    }
+}
+
 /// One photograph: the map solved for `scene`, written to `path`; None
 /// when no value could be solved.
 fn solve_one(

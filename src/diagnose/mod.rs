@@ -164,6 +164,7 @@ pub fn run(inputs: &Inputs, out: &Path, config: &DiagnoseConfig) -> Result<Diagn
         renders: fits.renders + 1,
         wall_seconds: started.elapsed().as_secs_f64(),
     };
+    albedo::prune(out, &model.scene);
     let residuals = (&residual_before, &residual_after);
     report::write(out, &diagnosis, &model.scene, &model.image, residuals)?;
     Ok(diagnosis)
