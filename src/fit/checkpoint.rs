@@ -27,6 +27,20 @@ pub struct Checkpoint {
     pub elapsed_before: f64,
 }
 
+/// A [`Checkpoint`] as written: the same fields, in the same order, the
+/// search borrowed.
+#[derive(Serialize)]
+struct Saved<'a> {
+    format: &'a str,
+    identity: &'a RunIdentity,
+    phase_index: usize,
+    base: &'a Scene,
+    search: Option<&'a Searcher>,
+    generation_offset: usize,
+    evaluations_before: usize,
+    elapsed_before: f64,
+}
+
 impl Checkpoint {
     pub fn start(base: Scene, identity: RunIdentity) -> Checkpoint {
         Checkpoint {
@@ -101,7 +115,26 @@ impl Checkpoint {
     }
 
     pub fn save(&self, dir: &RunDir) -> Result<()> {
-        dir.write_json(CHECKPOINT, self)
+        dir.write_json(CHECKPOINT, &self.saved(self.search.as_ref()))
+    }
+
+    /// Saves the checkpoint with `search` as its search, borrowed: the fit
+    /// saves after every generation and need not copy the search for it.
+    pub fn save_with(&self, dir: &RunDir, search: &Searcher) -> Result<()> {
+        dir.write_json(CHECKPOINT, &self.saved(Some(search)))
+    }
+
+    fn saved<'a>(&'a self, search: Option<&'a Searcher>) -> Saved<'a> {
+        Saved {
+            format: &self.format,
+            identity: &self.identity,
+            phase_index: self.phase_index,
+            base: &self.base,
+            search,
+            generation_offset: self.generation_offset,
+            evaluations_before: self.evaluations_before,
+            elapsed_before: self.elapsed_before,
+        }
     }
 
     /// The final (or current) population in scene units, for the report.

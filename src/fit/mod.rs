@@ -279,9 +279,7 @@ fn run_phase(
     let mut save = |s: &Searcher, seconds: f64| -> Result<()> {
         state.elapsed_before = offsets.seconds + seconds;
         if let Some(d) = dir {
-            state.search = Some(s.clone());
-            state.save(d)?;
-            state.search = None;
+            state.save_with(d, s)?;
         }
         Ok(())
     };

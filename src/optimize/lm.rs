@@ -208,31 +208,58 @@ fn cholesky(m: &[Vec<f64>]) -> Option<Vec<Vec<f64>>> {
 /// large (no longer a derivative) → halved; kept within
 /// [`STEP_MIN`, `STEP_MAX`].
 pub fn adapt_step(step: f64, center: &[f32], perturbed: Option<&[f32]>) -> f64 {
-    let Some(perturbed) = perturbed.filter(|p| p.len() == center.len()) else {
-        // A failed render near a point: try closer next time.
-        return (step * 0.5).clamp(STEP_MIN, STEP_MAX);
-    };
-    let (mut total, mut changed) = (0.0, 0usize);
-    for (&a, &b) in center.iter().zip(perturbed) {
-        let d = f64::from(b - a).abs();
-        if d > 0.0 {
-            total += d;
-            changed += 1;
+    let mut change = Change::default();
+    change.add(center, perturbed);
+    change.next_step(step)
+}
+
+/// What one coordinate's difference changed, summed over one or more
+/// residual vectors (a set's coordinate changes several photographs), for
+/// [`Change::next_step`].
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Change {
+    total: f64,
+    changed: usize,
+    failed: bool,
+}
+
+impl Change {
+    /// Adds one photograph's residuals at the point and at its perturbed
+    /// neighbour (None or a wrong length: the render failed).
+    pub fn add(&mut self, center: &[f32], perturbed: Option<&[f32]>) {
+        let Some(perturbed) = perturbed.filter(|p| p.len() == center.len()) else {
+            self.failed = true;
+            return;
+        };
+        for (&a, &b) in center.iter().zip(perturbed) {
+            let d = f64::from(b - a).abs();
+            if d > 0.0 {
+                self.total += d;
+                self.changed += 1;
+            }
         }
     }
-    let mean = if changed == 0 {
-        0.0
-    } else {
-        total / changed as f64
-    };
-    let next = if mean < CHANGE_LOW {
-        step * 4.0
-    } else if mean > CHANGE_HIGH {
-        step * 0.5
-    } else {
-        step
-    };
-    next.clamp(STEP_MIN, STEP_MAX)
+
+    /// The next step after `step` (see [`adapt_step`]).
+    pub fn next_step(&self, step: f64) -> f64 {
+        if self.failed {
+            // A failed render near a point: try closer next time.
+            return (step * 0.5).clamp(STEP_MIN, STEP_MAX);
+        }
+        let mean = if self.changed == 0 {
+            0.0
+        } else {
+            self.total / self.changed as f64
+        };
+        let next = if mean < CHANGE_LOW {
+            step * 4.0
+        } else if mean > CHANGE_HIGH {
+            step * 0.5
+        } else {
+            step
+        };
+        next.clamp(STEP_MIN, STEP_MAX)
+    }
 }
 
 /// The damped step's end point from `x` in the unit cube: coordinates on a

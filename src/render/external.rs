@@ -48,7 +48,7 @@ pub struct ExternalSession {
 }
 
 /// The run's private temporary directory (removed when the session ends).
-pub fn run_dir() -> Result<TempDir> {
+fn run_dir() -> Result<TempDir> {
     let dir = tempfile::Builder::new()
         .prefix("scenefit-run-")
         .tempdir()

@@ -159,6 +159,7 @@ impl Joint<'_> {
     /// photographs it changes; `steps` adapted to what they changed.
     fn normal(&mut self, x: &[f64], centre: &[Vec<f32>], steps: &mut [f64]) -> Normal {
         let mut scenes = Vec::new();
+        // The signed step of each perturbed render, in render order.
         let mut moved = Vec::new();
         for (i, shot) in self.shots.iter().enumerate() {
             for j in self.layout.columns_of(i) {
@@ -168,7 +169,7 @@ impl Joint<'_> {
                 } else {
                     x[j] - steps[j]
                 };
-                moved.push((i, j, y[j] - x[j]));
+                moved.push(y[j] - x[j]);
                 scenes.push((i, self.layout.scene(shot, i, &y)));
             }
         }
@@ -189,7 +190,7 @@ impl Joint<'_> {
             let columns: Vec<Column> = part
                 .iter()
                 .zip(steps_of)
-                .map(|(p, &(_, _, h))| Column {
+                .map(|(p, &h)| Column {
                     residuals: p.as_deref().ok(),
                     step: h,
                 })
@@ -211,23 +212,16 @@ impl Joint<'_> {
 /// Adapts each coordinate's difference step to the change it made, over
 /// every photograph it changed.
 fn adapt(steps: &mut [f64], layout: &Layout, centre: &[Vec<f32>], perturbed: &[Residuals]) {
-    let mut joined: Vec<(Vec<f32>, Vec<f32>, bool)> = vec![(vec![], vec![], true); steps.len()];
+    let mut changes = vec![lm::Change::default(); steps.len()];
     let mut at = 0;
     for (i, r) in centre.iter().enumerate() {
         for j in layout.columns_of(i) {
-            let entry = &mut joined[j];
-            match &perturbed[at] {
-                Ok(p) if p.len() == r.len() => {
-                    entry.0.extend_from_slice(r);
-                    entry.1.extend_from_slice(p);
-                }
-                _ => entry.2 = false,
-            }
+            changes[j].add(r, perturbed[at].as_deref().ok());
             at += 1;
         }
     }
-    for (step, (c, p, ok)) in steps.iter_mut().zip(&joined) {
-        *step = lm::adapt_step(*step, c, ok.then_some(p.as_slice()));
+    for (step, change) in steps.iter_mut().zip(&changes) {
+        *step = change.next_step(*step);
     }
 }
 
