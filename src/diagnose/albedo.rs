@@ -240,17 +240,17 @@ pub fn candidate(
         None,
         Refine::close(config, config.refine_generations),
     )?;
-    let mut best = (refit, count1, first.clone());
-    if let Some((again, count2)) = solve_one(fits, &best.0.scene, &second, out)? {
+    // The losing map stays on disk until the diagnosis prunes every map
+    // its final model does not name (`prune`).
+    let (mut fitted, mut count) = (refit, count1);
+    if let Some((again, count2)) = solve_one(fits, &fitted.scene, &second, out)? {
         fits.renders += 1;
         let image = render_one(fits.renderer(), &again, 0)?;
         let m = Model::new(again, image, fits.inputs);
-        if m.sad < best.0.sad {
-            best = (m, count2, second.clone());
+        if m.sad < fitted.sad {
+            (fitted, count) = (m, count2);
         }
     }
-    discard(if best.2 == first { &second } else { &first });
-    let (fitted, count, _) = best;
     let k0 = ParamSpace::from_scene(&model.scene).dim();
     let refit = "closed form, then warm";
     let c = Candidate::scored(NAME, round, fits.inputs, model, &fitted, k0, count, refit);
@@ -309,28 +309,24 @@ pub fn set_model(
     let Some((scene, count1)) = solve_set(fits, &model.scene, &model.own, &first)? else {
         return Ok(None);
     };
-    let refit = fits.run(&scene, &model.own)?;
-    let mut best = (refit, count1, first.clone());
-    if let Some((again, count2)) = solve_set(fits, &best.0.scene, &best.0.own, &second)? {
-        let shots = shots_of(&again, fits.inputs, &best.0.own)?;
+    // As for one photograph, the losing map is left to `prune`.
+    let (mut fitted, mut count) = (fits.run(&scene, &model.own)?, count1);
+    if let Some((again, count2)) = solve_set(fits, &fitted.scene, &fitted.own, &second)? {
+        let shots = shots_of(&again, fits.inputs, &fitted.own)?;
         if let Some((images, sad)) = fits.render(&shots)? {
-            if sad < best.0.sad {
-                let own = best.0.own.clone();
-                best = (
-                    SetModel {
-                        scene: again,
-                        own,
-                        images,
-                        sad,
-                    },
-                    count2,
-                    second.clone(),
-                );
+            if sad < fitted.sad {
+                let own = fitted.own.clone();
+                fitted = SetModel {
+                    scene: again,
+                    own,
+                    images,
+                    sad,
+                };
+                count = count2;
             }
         }
     }
-    discard(if best.2 == first { &second } else { &first });
-    Ok(Some((best.0, best.1)))
+    Ok(Some((fitted, count)))
 }
 
 #[cfg(test)]

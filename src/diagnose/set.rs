@@ -232,20 +232,22 @@ impl SetRefits<'_> {
             if pooled(&have) <= 0.0 {
                 continue;
             }
-            let shared =
-                effects::edit::match_level_where(start, pooled(&want) / pooled(&have), |f| {
-                    !f.per_shot
-                });
+            let k_shared = pooled(&want) / pooled(&have);
+            let shared = effects::edit::match_level_where(start, k_shared, |f| !f.per_shot);
             let space = ParamSpace::from_scene(start);
-            let matched: Vec<Shot> = shots_of(&shared, inputs, own)?
-                .into_iter()
+            // Each shot's scene already holds the start with its own values:
+            // the same two scalings applied there, no rebuild needed.
+            let matched: Vec<Shot> = shots
+                .iter()
                 .zip(want.iter().zip(&have))
                 .map(|(s, (w, h))| {
                     let k = if h.1 > 0.0 { w.1 / h.1 } else { 1.0 };
-                    let scene = effects::edit::match_level_where(&s.scene, k, |f| {
+                    let scene =
+                        effects::edit::match_level_where(&s.scene, k_shared, |f| !f.per_shot);
+                    let scene = effects::edit::match_level_where(&scene, k, |f| {
                         f.per_shot && !s.entry.set.contains_key(&f.param)
                     });
-                    Shot { scene, ..s }
+                    Shot { scene, ..s.clone() }
                 })
                 .collect();
             if let Some((_, d)) = self.render(&matched)? {
