@@ -22,6 +22,7 @@ mod albedo;
 mod config;
 pub mod effects;
 mod inputs;
+mod lanes;
 pub mod output;
 pub mod photo;
 mod refit;
@@ -37,7 +38,7 @@ pub use inputs::Inputs;
 use crate::error::{Error, Result};
 use crate::metric::{deviation, Deviation};
 use crate::render::{from_spec_with, render_one};
-use crate::scene::ParamSpace;
+use crate::scene::{ParamSpace, Scene};
 use effects::Effect;
 use refit::{Model, Refine, Refits, Search};
 use residual::Residual;
@@ -188,22 +189,24 @@ fn run_round(
 ) -> Result<Round> {
     let inputs = fits.inputs;
     let residual = Residual::new(&inputs.target, &model.image, inputs.mask.as_ref());
+    let open: Vec<&dyn Effect> = effects::ALL
+        .iter()
+        .copied()
+        .filter(|e| !accepted.iter().any(|a| a == e.name()))
+        .collect();
+    let searched: Vec<&dyn Effect> = open.iter().copied().filter(|e| !e.closed_form()).collect();
+    let mut refitted = try_effects(fits, model, &searched, round)?.into_iter();
     let mut tried: Vec<(Candidate, Model)> = Vec::new();
-    for &effect in effects::ALL {
-        if accepted.iter().any(|a| a == effect.name()) {
-            continue;
-        }
-        let evidence = residual.evidence(effect);
-        let found = if effect.closed_form() {
-            if effect.applies(&model.scene) {
-                albedo::candidate(fits, model, round, out)?
-            } else {
-                None
-            }
+    for effect in open {
+        let found = if !effect.closed_form() {
+            refitted.next().flatten()
+        } else if effect.applies(&model.scene) {
+            albedo::candidate(fits, model, round, out)?
         } else {
-            try_effect(fits, model, effect, round)?
+            None
         };
         if let Some((c, m)) = found {
+            let evidence = residual.evidence(effect);
             tried.push((Candidate { evidence, ..c }, m));
         }
     }
@@ -221,39 +224,112 @@ fn run_round(
     })
 }
 
-/// `effect` added to `model` and refitted warm (from its best start) and,
-/// when configured, from scratch; the better counts. None: the effect does
-/// not apply. The candidate's evidence is left at 0 for the caller.
-fn try_effect(
+/// An effect added to the model, ready for its refits.
+struct Trial {
+    effect: &'static dyn Effect,
+    /// The extended scene's best start.
+    start: Scene,
+    /// The entries its own search moves.
+    search: Vec<crate::scene::FreeParam>,
+    radius: f64,
+    /// Free values before, and added.
+    k0: usize,
+    added: usize,
+}
+
+/// Each effect added to `model` and refitted warm (from its best start)
+/// and, when configured, from scratch; the better counts. None for an
+/// effect that does not apply. Every refit of the round runs side by side
+/// with the others (`lanes.rs`); candidates' evidence is left at 0.
+fn try_effects(
     fits: &mut Refits,
     model: &Model,
-    effect: &dyn Effect,
+    effects: &[&'static dyn Effect],
     round: usize,
-) -> Result<Option<(Candidate, Model)>> {
+) -> Result<Vec<Option<(Candidate, Model)>>> {
+    let trials: Vec<Option<Trial>> = fits
+        .side_by_side(effects, |f, &e| prepare(f, model, e))
+        .into_iter()
+        .collect::<Result<_>>()?;
+    let config = fits.config;
+    let scratch = config.restart_generations > 0;
+    // (trial, from scratch), the refits from scratch first: they are the
+    // longest, and lanes take tasks in order.
+    let mut refits: Vec<(usize, bool)> = Vec::new();
+    for from_scratch in [true, false] {
+        if from_scratch && !scratch {
+            continue;
+        }
+        let ready = trials.iter().enumerate().filter(|(_, t)| t.is_some());
+        refits.extend(ready.map(|(i, _)| (i, from_scratch)));
+    }
+    let done = fits.side_by_side(&refits, |f, &(i, from_scratch)| {
+        let t = trials[i]
+            .as_ref()
+            .expect("only prepared trials are refitted");
+        if from_scratch {
+            f.run(&t.start, None, Refine::restart(config))
+        } else {
+            let search = Search {
+                params: t.search.clone(),
+                radius: t.radius,
+            };
+            let close = Refine::close(config, config.refine_generations);
+            f.run(&t.start, Some(search), close)
+        }
+    });
+    let mut warm: Vec<Option<Model>> = trials.iter().map(|_| None).collect();
+    let mut again: Vec<Option<Model>> = trials.iter().map(|_| None).collect();
+    for (&(i, from_scratch), m) in refits.iter().zip(done) {
+        let slot = if from_scratch { &mut again } else { &mut warm };
+        slot[i] = Some(m?);
+    }
+    let mut out = Vec::new();
+    for ((trial, warm), again) in trials.into_iter().zip(warm).zip(again) {
+        let (Some(t), Some(mut fitted)) = (trial, warm) else {
+            out.push(None);
+            continue;
+        };
+        let mut refit = "warm";
+        if let Some(again) = again {
+            if again.sad < fitted.sad {
+                refit = "from scratch";
+            }
+            fitted = fitted.better(again);
+        }
+        let name = t.effect.name();
+        let c = Candidate::scored(
+            name,
+            round,
+            fits.inputs,
+            model,
+            &fitted,
+            t.k0,
+            t.added,
+            refit,
+        );
+        out.push(Some((c, fitted)));
+    }
+    Ok(out)
+}
+
+/// `effect` added to `model` at its best start (renders counted in
+/// `fits`), or None when it does not apply.
+fn prepare(fits: &mut Refits, model: &Model, effect: &'static dyn Effect) -> Result<Option<Trial>> {
     let Some(ext) = effects::extend(effect, &model.scene) else {
         return Ok(None);
     };
-    let config = fits.config;
     let k0 = ParamSpace::from_scene(&model.scene).dim();
     let added = ParamSpace::from_scene(&ext.scene).dim() - k0;
     let (start, count) = starts::best_start(fits.renderer(), &ext, fits.inputs)?;
     fits.renders += count;
     let trades = effect.trades();
-    let search = Search {
-        params: trades.search(&start, &ext.added),
+    Ok(Some(Trial {
+        effect,
+        search: trades.search(&start, &ext.added),
         radius: trades.radius,
-    };
-    let name = effect.name();
-    let close = Refine::close(config, config.refine_generations);
-    let mut fitted = fits.run(&start, Some(search), close)?;
-    let mut refit = "warm";
-    if config.restart_generations > 0 {
-        let again = fits.run(&start, None, Refine::restart(config))?;
-        if again.sad < fitted.sad {
-            refit = "from scratch";
-        }
-        fitted = fitted.better(again);
-    }
-    let candidate = Candidate::scored(name, round, fits.inputs, model, &fitted, k0, added, refit);
-    Ok(Some((candidate, fitted)))
+        start,
+        k0,
+        added,
+    }))
 }

@@ -98,6 +98,8 @@ pub struct Refits<'a> {
     pub inputs: &'a Inputs,
     pub config: &'a DiagnoseConfig,
     target: FitTarget,
+    /// Renders at once in each of its fits (its lane's share, `lanes.rs`).
+    jobs: usize,
     pub renders: usize,
 }
 
@@ -119,7 +121,19 @@ impl<'a> Refits<'a> {
             inputs,
             config,
             target,
+            jobs: config.jobs,
             renders: 0,
+        }
+    }
+
+    /// The same refits for one lane, with `jobs` renders at once and its
+    /// own count of renders (added back by the caller).
+    pub fn lane(&self, jobs: usize) -> Refits<'a> {
+        Refits {
+            target: self.target.clone(),
+            jobs,
+            renders: 0,
+            ..*self
         }
     }
 
@@ -135,11 +149,34 @@ impl<'a> Refits<'a> {
         let warm = Refine::close(c, c.search_generations + c.refine_generations);
         let null = self.run(&model.scene, None, warm)?;
         let mut model = model.better(null);
+        // After the warm refit, not beside it: its result is one
+        // individual of this start.
         if c.restart_generations > 0 {
             let again = self.run(&model.scene, None, Refine::restart(c))?;
             model = model.better(again);
         }
         Ok(model)
+    }
+
+    /// `refit(lane, item)` for every item, side by side in lanes
+    /// (`lanes.rs`), their renders counted here; results in item order.
+    pub fn side_by_side<I: Sync, T: Send>(
+        &mut self,
+        items: &[I],
+        refit: impl Fn(&mut Refits<'a>, &I) -> T + Sync,
+    ) -> Vec<T> {
+        let this = &*self;
+        let done = super::lanes::run(self.jobs, items.len(), |i, jobs| {
+            let mut lane = this.lane(jobs);
+            let out = refit(&mut lane, &items[i]);
+            (out, lane.renders)
+        });
+        done.into_iter()
+            .map(|(out, renders)| {
+                self.renders += renders;
+                out
+            })
+            .collect()
     }
 
     /// Refits `scene`: with a `search`, first those entries
@@ -193,7 +230,7 @@ impl<'a> Refits<'a> {
                 },
                 ..DeConfig::default()
             },
-            jobs: self.config.jobs,
+            jobs: self.jobs,
             snapshot_every: usize::MAX / 2,
             // A refit costs what it needs: it ends when the local phase
             // converges, so refits compared by the criterion each reach

@@ -22,6 +22,50 @@ pub fn decode(v: u8) -> f64 {
     }
 }
 
+/// Buckets of the linear range in [`encode_exact`]'s table.
+const BUCKETS: usize = 4096;
+
+/// [`encode`]'s result without its power: the code from a table of where
+/// each code starts, found from a coarse table of the linear range. The
+/// same as `encode` (up to rounding of a value exactly on a boundary), for
+/// image-space passes that must match the exact encoding.
+pub fn encode_exact(x: f64) -> u8 {
+    struct Table {
+        /// Least linear value of each code above 0.
+        starts: [f64; 256],
+        /// The code of each bucket's lowest value.
+        first: [u8; BUCKETS + 1],
+    }
+    static TABLE: std::sync::OnceLock<Table> = std::sync::OnceLock::new();
+    let t = TABLE.get_or_init(|| {
+        // Code k starts where s * 255 + 0.5 reaches k.
+        let starts = std::array::from_fn(|k| match k {
+            0 => f64::NEG_INFINITY,
+            _ => {
+                let s = (k as f64 - 0.5) / 255.0;
+                if s <= 12.92 * 0.0031308 {
+                    s / 12.92
+                } else {
+                    ((s + 0.055) / 1.055).powf(2.4)
+                }
+            }
+        });
+        let first = std::array::from_fn(|i| encode(i as f64 / BUCKETS as f64));
+        Table { starts, first }
+    });
+    // NaN becomes 0, as `encode`'s clamp and `as` make it.
+    let x = if x.is_nan() { 0.0 } else { x.clamp(0.0, 1.0) };
+    let mut code = t.first[(x * BUCKETS as f64) as usize];
+    while code < 255 && x >= t.starts[code as usize + 1] {
+        code += 1;
+    }
+    // A value just below a bucket's edge by rounding of the product.
+    while code > 0 && x < t.starts[code as usize] {
+        code -= 1;
+    }
+    code
+}
+
 /// Coefficients of 1.055 * t^(5/3) - 0.055 as a degree-5 polynomial in
 /// t = x^(1/4) over [0.0031308^(1/4), 1] (a Chebyshev fit; its largest
 /// error is 0.0045 of an 8-bit step).
@@ -89,6 +133,25 @@ mod tests {
         assert_eq!(encode(0.0), 0);
         assert_eq!(encode(1.0), 255);
         assert_eq!(encode(2.0), 255);
+    }
+
+    #[test]
+    fn the_exact_table_matches_encode() {
+        let n = 2_000_000;
+        let mut off = 0;
+        for i in 0..=n {
+            // Even steps, and values clustered near 0 where codes are narrow.
+            for x in [i as f64 / n as f64, (i as f64 / n as f64).powi(3)] {
+                off += (encode_exact(x) != encode(x)) as usize;
+            }
+        }
+        assert!(off <= 2, "{off} values differ");
+        for k in 0..=255u8 {
+            assert_eq!(encode_exact(decode(k)), k);
+        }
+        assert_eq!(encode_exact(f64::NAN), encode(f64::NAN));
+        assert_eq!(encode_exact(-1.0), 0);
+        assert_eq!(encode_exact(7.0), 255);
     }
 
     #[test]

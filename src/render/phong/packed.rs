@@ -47,6 +47,11 @@ pub struct Packed {
     /// When every hit is a camera hit and pixels have one sample: the pixel
     /// of each packed hit (no weights to propagate).
     pub direct_pixel: Option<Vec<u32>>,
+    /// The one-bounce kernel, built on first use (`effects.rs`).
+    bounce: std::sync::OnceLock<super::effects::Bounce>,
+    /// For each group, the primitives of other objects (which alone can
+    /// shadow a convex object's hits), built on first use.
+    others: std::sync::OnceLock<Vec<Vec<u32>>>,
 }
 
 impl Packed {
@@ -114,6 +119,8 @@ impl Packed {
         Packed {
             n,
             groups,
+            bounce: std::sync::OnceLock::new(),
+            others: std::sync::OnceLock::new(),
             px: col(&|i| v[i].p.x),
             py: col(&|i| v[i].p.y),
             pz: col(&|i| v[i].p.z),
@@ -127,5 +134,26 @@ impl Packed {
             packed_of,
             lights: packs,
         }
+    }
+
+    /// The one-bounce kernel of these hits.
+    pub fn bounce(&self) -> &super::effects::Bounce {
+        self.bounce
+            .get_or_init(|| super::effects::Bounce::new(self))
+    }
+
+    /// For each group, the primitives of `geo` owned by other objects. Our
+    /// shapes are convex, so a hit is never shadowed by its own object.
+    pub fn others(&self, geo: &super::geometry::Geometry) -> &[Vec<u32>] {
+        self.others.get_or_init(|| {
+            self.groups
+                .iter()
+                .map(|g| {
+                    (0..geo.prims.len() as u32)
+                        .filter(|&i| geo.owner[i as usize] != g.object)
+                        .collect()
+                })
+                .collect()
+        })
     }
 }
