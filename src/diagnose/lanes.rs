@@ -12,6 +12,38 @@
 
 use std::sync::atomic::{AtomicUsize, Ordering};
 
+/// What runs refits and counts their renders, split into lanes.
+pub trait Lanes: Sized + Send + Sync {
+    /// Renders at once.
+    fn jobs(&self) -> usize;
+    /// The same refits with `jobs` renders at once and none counted yet.
+    fn lane(&self, jobs: usize) -> Self;
+    /// Renders counted so far.
+    fn renders(&self) -> usize;
+    fn add_renders(&mut self, n: usize);
+}
+
+/// `refit(lane, item)` for every item, side by side in lanes, their
+/// renders counted in `fits`; results in item order.
+pub fn side_by_side<R: Lanes, I: Sync, T: Send>(
+    fits: &mut R,
+    items: &[I],
+    refit: impl Fn(&mut R, &I) -> T + Sync,
+) -> Vec<T> {
+    let this = &*fits;
+    let done = run(fits.jobs(), items.len(), |i, jobs| {
+        let mut lane = this.lane(jobs);
+        let out = refit(&mut lane, &items[i]);
+        (out, lane.renders())
+    });
+    done.into_iter()
+        .map(|(out, renders)| {
+            fits.add_renders(renders);
+            out
+        })
+        .collect()
+}
+
 /// Runs `task(i, jobs_of_its_lane)` for every `i < n` on up to `jobs`
 /// lanes, and returns the results in the order of `i`. Tasks are taken in
 /// order as lanes come free, so put the longest first.

@@ -247,8 +247,7 @@ fn try_effects(
     effects: &[&'static dyn Effect],
     round: usize,
 ) -> Result<Vec<Option<(Candidate, Model)>>> {
-    let trials: Vec<Option<Trial>> = fits
-        .side_by_side(effects, |f, &e| prepare(f, model, e))
+    let trials: Vec<Option<Trial>> = lanes::side_by_side(fits, effects, |f, &e| prepare(f, model, e))
         .into_iter()
         .collect::<Result<_>>()?;
     let config = fits.config;
@@ -263,7 +262,7 @@ fn try_effects(
         let ready = trials.iter().enumerate().filter(|(_, t)| t.is_some());
         refits.extend(ready.map(|(i, _)| (i, from_scratch)));
     }
-    let done = fits.side_by_side(&refits, |f, &(i, from_scratch)| {
+    let done = lanes::side_by_side(fits, &refits, |f, &(i, from_scratch)| {
         let t = trials[i]
             .as_ref()
             .expect("only prepared trials are refitted");

@@ -126,16 +126,6 @@ impl<'a> Refits<'a> {
         }
     }
 
-    /// The same refits for one lane, with `jobs` renders at once and its
-    /// own count of renders (added back by the caller).
-    pub fn lane(&self, jobs: usize) -> Refits<'a> {
-        Refits {
-            target: self.target.clone(),
-            jobs,
-            renders: 0,
-            ..*self
-        }
-    }
 
     pub fn renderer(&self) -> &'a dyn Renderer {
         self.renderer
@@ -156,27 +146,6 @@ impl<'a> Refits<'a> {
             model = model.better(again);
         }
         Ok(model)
-    }
-
-    /// `refit(lane, item)` for every item, side by side in lanes
-    /// (`lanes.rs`), their renders counted here; results in item order.
-    pub fn side_by_side<I: Sync, T: Send>(
-        &mut self,
-        items: &[I],
-        refit: impl Fn(&mut Refits<'a>, &I) -> T + Sync,
-    ) -> Vec<T> {
-        let this = &*self;
-        let done = super::lanes::run(self.jobs, items.len(), |i, jobs| {
-            let mut lane = this.lane(jobs);
-            let out = refit(&mut lane, &items[i]);
-            (out, lane.renders)
-        });
-        done.into_iter()
-            .map(|(out, renders)| {
-                self.renders += renders;
-                out
-            })
-            .collect()
     }
 
     /// Refits `scene`: with a `search`, first those entries
@@ -241,5 +210,28 @@ impl<'a> Refits<'a> {
         let r = fit::run_in_memory(scene, &self.target, self.renderer, &config, &mut ())?;
         self.renders += r.result.evaluations;
         Ok((r.scene, r.image))
+    }
+}
+
+impl super::lanes::Lanes for Refits<'_> {
+    fn jobs(&self) -> usize {
+        self.jobs
+    }
+
+    fn lane(&self, jobs: usize) -> Self {
+        Refits {
+            target: self.target.clone(),
+            jobs,
+            renders: 0,
+            ..*self
+        }
+    }
+
+    fn renders(&self) -> usize {
+        self.renders
+    }
+
+    fn add_renders(&mut self, n: usize) {
+        self.renders += n;
     }
 }

@@ -166,16 +166,40 @@ pub(super) struct SetRefits<'a> {
     renderer: &'a dyn Renderer,
     pub(super) inputs: &'a SetInputs,
     config: &'a DiagnoseConfig,
+    /// Renders at once (its lane's share, `lanes.rs`).
+    jobs: usize,
     renders: usize,
     /// The diagnosis's directory (closed-form effects write their maps there).
     pub(super) out: &'a Path,
+}
+
+impl super::lanes::Lanes for SetRefits<'_> {
+    fn jobs(&self) -> usize {
+        self.jobs
+    }
+
+    fn lane(&self, jobs: usize) -> Self {
+        SetRefits {
+            jobs,
+            renders: 0,
+            ..*self
+        }
+    }
+
+    fn renders(&self) -> usize {
+        self.renders
+    }
+
+    fn add_renders(&mut self, n: usize) {
+        self.renders += n;
+    }
 }
 
 impl SetRefits<'_> {
     /// Renders every photograph's scene in `shots`: the images and the
     /// set's sum of absolute differences (None: a render failed).
     pub(super) fn render(&mut self, shots: &[Shot]) -> Result<Option<(Vec<Image>, f64)>> {
-        let scored = score(self.renderer, shots, self.config.jobs)?;
+        let scored = score(self.renderer, shots, self.jobs)?;
         self.renders += shots.len();
         Ok(scored
             .into_iter()
@@ -278,7 +302,7 @@ impl SetRefits<'_> {
                     strategy: Strategy::Hybrid,
                     ..DeConfig::default()
                 },
-                jobs: c.jobs,
+                jobs: self.jobs,
                 snapshot_every: usize::MAX / 2,
                 ..FitConfig::default()
             },
@@ -370,6 +394,7 @@ pub fn run(inputs: &SetInputs, out: &Path, config: &DiagnoseConfig) -> Result<Se
         renderer: renderer.as_ref(),
         inputs,
         config,
+        jobs: config.jobs,
         renders: inputs.shots.len(),
         out,
     };
@@ -441,11 +466,24 @@ fn rounds(
     for round in 1..=fits.config.max_rounds {
         let residuals = model.residuals(inputs);
         let k0 = model.dim(inputs);
+        let open: Vec<&dyn Effect> = effects::ALL
+            .iter()
+            .copied()
+            .filter(|e| !accepted.iter().any(|a| a == e.name()))
+            .collect();
+        // The searched effects' refits side by side (`lanes.rs`).
+        let searched: Vec<&dyn Effect> = open.iter().copied().filter(|e| !e.closed_form()).collect();
+        let current = &*model;
+        let refitted = super::lanes::side_by_side(fits, &searched, |f, &effect| {
+            let Some(ext) = effects::extend(effect, &current.scene) else {
+                return Ok(None);
+            };
+            let (start, own) = f.best_start(&ext, &current.own)?;
+            f.run(&start, &own).map(Some)
+        });
+        let mut refitted = refitted.into_iter();
         let mut tried: Vec<(Candidate, SetModel)> = Vec::new();
-        for &effect in effects::ALL {
-            if accepted.iter().any(|a| a == effect.name()) {
-                continue;
-            }
+        for effect in open {
             let (fitted, k) = if effect.closed_form() {
                 let solved = match effect.applies(&model.scene) {
                     true => super::albedo::set_model(fits, model, round)?,
@@ -457,11 +495,9 @@ fn rounds(
                 let k = fitted.dim(inputs) + values;
                 (fitted, k)
             } else {
-                let Some(ext) = effects::extend(effect, &model.scene) else {
+                let Some(fitted) = refitted.next().expect("one result per searched effect")? else {
                     continue;
                 };
-                let (start, own) = fits.best_start(&ext, &model.own)?;
-                let fitted = fits.run(&start, &own)?;
                 let k = fitted.dim(inputs);
                 (fitted, k)
             };
