@@ -1,7 +1,7 @@
 //! `scenefit diagnose` on generated data (tests/effects_data): the first
 //! accepted effect is the planted one for at least 8 of the 9 effects, the
-//! deviation falls to at most half for every one, and noise-only targets
-//! accept nothing.
+//! deviation falls to at most half for every one, noise-only targets
+//! accept nothing, and the diagnosis does not depend on `--jobs`.
 
 mod effects_data;
 
@@ -9,6 +9,16 @@ use effects_data::{case, effects, fit_case};
 use scenefit::diagnose::{self, DiagnoseConfig, Inputs};
 
 fn diagnose_case(effect: &str, variant: u32, seed: u64, noise: f64) -> diagnose::Diagnosis {
+    diagnose_case_with(effect, variant, seed, noise, DiagnoseConfig::default().jobs)
+}
+
+fn diagnose_case_with(
+    effect: &str,
+    variant: u32,
+    seed: u64,
+    noise: f64,
+    jobs: usize,
+) -> diagnose::Diagnosis {
     let c = case(effect, variant, 1.0, seed, noise);
     let tmp = tempfile::tempdir().unwrap();
     // DIAG_KEEP=DIR keeps each case's fit and diagnosis there (when tuning).
@@ -23,6 +33,7 @@ fn diagnose_case(effect: &str, variant: u32, seed: u64, noise: f64) -> diagnose:
     let config = DiagnoseConfig {
         max_rounds: 1,
         seed,
+        jobs,
         ..DiagnoseConfig::default()
     };
     diagnose::run(&inputs, &dir.join("diag"), &config).unwrap()
@@ -94,4 +105,21 @@ fn noise_only_targets_accept_nothing() {
             "noise {noise}: structure reported in pure noise"
         );
     }
+}
+
+/// The refits run side by side in as many lanes as jobs: the diagnosis
+/// must not depend on how many.
+#[test]
+fn the_diagnosis_is_the_same_whatever_the_jobs() {
+    let runs: Vec<String> = [1, 3]
+        .iter()
+        .map(|&jobs| {
+            let d = diagnose_case_with("vignetting", 0, 5, 0.0, jobs);
+            let mut v = serde_json::to_value(&d).unwrap();
+            v.as_object_mut().unwrap().remove("wall_seconds");
+            v.to_string()
+        })
+        .collect();
+    assert!(runs[0].contains("vignetting"), "{}", runs[0]);
+    assert_eq!(runs[0], runs[1]);
 }

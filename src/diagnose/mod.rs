@@ -247,9 +247,10 @@ fn try_effects(
     effects: &[&'static dyn Effect],
     round: usize,
 ) -> Result<Vec<Option<(Candidate, Model)>>> {
-    let trials: Vec<Option<Trial>> = lanes::side_by_side(fits, effects, |f, &e| prepare(f, model, e))
-        .into_iter()
-        .collect::<Result<_>>()?;
+    let trials: Vec<Option<Trial>> =
+        lanes::side_by_side(fits, effects, |f, &e| prepare(f, model, e))
+            .into_iter()
+            .collect::<Result<_>>()?;
     let config = fits.config;
     let scratch = config.restart_generations > 0;
     // (trial, from scratch), the refits from scratch first: they are the

@@ -126,7 +126,6 @@ impl<'a> Refits<'a> {
         }
     }
 
-
     pub fn renderer(&self) -> &'a dyn Renderer {
         self.renderer
     }

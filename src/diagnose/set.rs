@@ -472,7 +472,8 @@ fn rounds(
             .filter(|e| !accepted.iter().any(|a| a == e.name()))
             .collect();
         // The searched effects' refits side by side (`lanes.rs`).
-        let searched: Vec<&dyn Effect> = open.iter().copied().filter(|e| !e.closed_form()).collect();
+        let searched: Vec<&dyn Effect> =
+            open.iter().copied().filter(|e| !e.closed_form()).collect();
         let current = &*model;
         let refitted = super::lanes::side_by_side(fits, &searched, |f, &effect| {
             let Some(ext) = effects::extend(effect, &current.scene) else {
