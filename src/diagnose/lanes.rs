@@ -16,6 +16,8 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 pub trait Lanes: Sized + Send + Sync {
     /// Renders at once.
     fn jobs(&self) -> usize;
+    /// Lanes at most (see [`lanes_for`]).
+    fn lanes(&self) -> usize;
     /// The same refits with `jobs` renders at once and none counted yet.
     fn lane(&self, jobs: usize) -> Self;
     /// Renders counted so far.
@@ -31,7 +33,7 @@ pub fn side_by_side<R: Lanes, I: Sync, T: Send>(
     refit: impl Fn(&mut R, &I) -> T + Sync,
 ) -> Vec<T> {
     let this = &*fits;
-    let done = run(fits.jobs(), items.len(), |i, jobs| {
+    let done = run(fits.lanes(), fits.jobs(), items.len(), |i, jobs| {
         let mut lane = this.lane(jobs);
         let out = refit(&mut lane, &items[i]);
         (out, lane.renders())
@@ -44,11 +46,27 @@ pub fn side_by_side<R: Lanes, I: Sync, T: Send>(
         .collect()
 }
 
-/// Runs `task(i, jobs_of_its_lane)` for every `i < n` on up to `jobs`
-/// lanes, and returns the results in the order of `i`. Tasks are taken in
-/// order as lanes come free, so put the longest first.
-pub fn run<T: Send>(jobs: usize, n: usize, task: impl Fn(usize, usize) -> T + Sync) -> Vec<T> {
-    let lanes = jobs.min(n).max(1);
+/// Lanes for a diagnosis with `jobs` renders at once: one per job, but
+/// one only when the user fixed the renderer's workers (`--workers`), a
+/// count per session that lanes, each with its session, would multiply.
+pub fn lanes_for(config: &super::DiagnoseConfig, jobs: usize) -> usize {
+    match config.render_options.workers {
+        Some(_) => 1,
+        None => jobs,
+    }
+}
+
+/// Runs `task(i, jobs_of_its_lane)` for every `i < n` on up to `lanes`
+/// lanes (and no more than `jobs`), and returns the results in the order
+/// of `i`. Tasks are taken in order as lanes come free, so put the longest
+/// first.
+pub fn run<T: Send>(
+    lanes: usize,
+    jobs: usize,
+    n: usize,
+    task: impl Fn(usize, usize) -> T + Sync,
+) -> Vec<T> {
+    let lanes = lanes.min(jobs).min(n).max(1);
     if lanes == 1 {
         return (0..n).map(|i| task(i, jobs.max(1))).collect();
     }
@@ -89,7 +107,7 @@ mod tests {
     #[test]
     fn results_come_back_in_task_order_whatever_the_lanes() {
         for jobs in [1, 2, 3, 8] {
-            let out = run(jobs, 7, |i, _| i * i);
+            let out = run(jobs, jobs, 7, |i, _| i * i);
             assert_eq!(out, vec![0, 1, 4, 9, 16, 25, 36], "jobs {jobs}");
         }
     }
@@ -98,7 +116,7 @@ mod tests {
     fn lanes_split_the_jobs_and_run_at_once() {
         let threads = Mutex::new(HashSet::new());
         let started = AtomicUsize::new(0);
-        let shares = run(5, 2, |_, share| {
+        let shares = run(5, 5, 2, |_, share| {
             threads.lock().unwrap().insert(std::thread::current().id());
             // Each task waits (a while at most) for the other to start:
             // both see it only if they run at once.
@@ -113,7 +131,9 @@ mod tests {
         assert!(shares.iter().all(|s| s.0 >= 2 && s.1 == 2), "{shares:?}");
         assert_eq!(threads.lock().unwrap().len(), 2);
         // One lane: every task on the calling thread, with all the jobs.
-        assert_eq!(run(1, 3, |_, share| share), vec![1, 1, 1]);
-        assert_eq!(run(4, 1, |_, share| share), vec![4]);
+        assert_eq!(run(1, 1, 3, |_, share| share), vec![1, 1, 1]);
+        assert_eq!(run(4, 4, 1, |_, share| share), vec![4]);
+        // Lanes capped: one lane keeps all the jobs.
+        assert_eq!(run(1, 4, 2, |_, share| share), vec![4, 4]);
     }
 }

@@ -217,6 +217,10 @@ impl super::lanes::Lanes for Refits<'_> {
         self.jobs
     }
 
+    fn lanes(&self) -> usize {
+        super::lanes::lanes_for(self.config, self.jobs)
+    }
+
     fn lane(&self, jobs: usize) -> Self {
         Refits {
             target: self.target.clone(),

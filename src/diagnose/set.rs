@@ -178,6 +178,10 @@ impl super::lanes::Lanes for SetRefits<'_> {
         self.jobs
     }
 
+    fn lanes(&self) -> usize {
+        super::lanes::lanes_for(self.config, self.jobs)
+    }
+
     fn lane(&self, jobs: usize) -> Self {
         SetRefits {
             jobs,
