@@ -87,6 +87,7 @@ fn each_effect_changes_the_image() {
                     gain: 1.3,
                     gamma: 0.8,
                     black: 0.02,
+                    ..Default::default()
                 })
             }),
         ),

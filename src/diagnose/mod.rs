@@ -238,19 +238,26 @@ struct Trial {
 }
 
 /// Each effect added to `model` and refitted warm (from its best start)
-/// and, when configured, from scratch; the better counts. None for an
-/// effect that does not apply. Every refit of the round runs side by side
-/// with the others (`lanes.rs`); candidates' evidence is left at 0.
+/// and, when configured, from scratch, in each of its forms; the best
+/// refit counts. None for an effect that does not apply. Every refit of
+/// the round runs side by side with the others (`lanes.rs`); candidates'
+/// evidence is left at 0.
 fn try_effects(
     fits: &mut Refits,
     model: &Model,
     effects: &[&'static dyn Effect],
     round: usize,
 ) -> Result<Vec<Option<(Candidate, Model)>>> {
-    let trials: Vec<Option<Trial>> =
+    let prepared: Vec<Vec<Trial>> =
         lanes::side_by_side(fits, effects, |f, &e| prepare(f, model, e))
             .into_iter()
             .collect::<Result<_>>()?;
+    // Every form of every effect, with the index of its effect.
+    let trials: Vec<(usize, Trial)> = prepared
+        .into_iter()
+        .enumerate()
+        .flat_map(|(e, forms)| forms.into_iter().map(move |t| (e, t)))
+        .collect();
     let config = fits.config;
     let scratch = config.restart_generations > 0;
     // (trial, from scratch), the refits from scratch first: they are the
@@ -260,13 +267,10 @@ fn try_effects(
         if from_scratch && !scratch {
             continue;
         }
-        let ready = trials.iter().enumerate().filter(|(_, t)| t.is_some());
-        refits.extend(ready.map(|(i, _)| (i, from_scratch)));
+        refits.extend((0..trials.len()).map(|i| (i, from_scratch)));
     }
     let done = lanes::side_by_side(fits, &refits, |f, &(i, from_scratch)| {
-        let t = trials[i]
-            .as_ref()
-            .expect("only prepared trials are refitted");
+        let t = &trials[i].1;
         if from_scratch {
             f.run(&t.start, None, Refine::restart(config))
         } else {
@@ -278,58 +282,61 @@ fn try_effects(
             f.run(&t.start, Some(search), close)
         }
     });
-    let mut warm: Vec<Option<Model>> = trials.iter().map(|_| None).collect();
-    let mut again: Vec<Option<Model>> = trials.iter().map(|_| None).collect();
+    let mut results: Vec<[Option<Model>; 2]> = trials.iter().map(|_| [None, None]).collect();
     for (&(i, from_scratch), m) in refits.iter().zip(done) {
-        let slot = if from_scratch { &mut again } else { &mut warm };
-        slot[i] = Some(m?);
+        results[i][from_scratch as usize] = Some(m?);
     }
-    let mut out = Vec::new();
-    for ((trial, warm), again) in trials.into_iter().zip(warm).zip(again) {
-        let (Some(t), Some(mut fitted)) = (trial, warm) else {
-            out.push(None);
-            continue;
-        };
-        let mut refit = "warm";
-        if let Some(again) = again {
-            if again.sad < fitted.sad {
-                refit = "from scratch";
+    // The best refit of each effect over its forms, the neutral form's
+    // warm refit first: a tie keeps the earlier.
+    let mut best: Vec<Option<(Model, &'static str, &Trial)>> =
+        effects.iter().map(|_| None).collect();
+    for ((e, t), refitted) in trials.iter().zip(results) {
+        for (m, refit) in refitted.into_iter().zip(["warm", "from scratch"]) {
+            let Some(m) = m else { continue };
+            let slot = &mut best[*e];
+            if slot.as_ref().is_none_or(|b| m.sad < b.0.sad) {
+                *slot = Some((m, refit, t));
             }
-            fitted = fitted.better(again);
         }
-        let name = t.effect.name();
-        let c = Candidate::scored(
-            name,
-            round,
-            fits.inputs,
-            model,
-            &fitted,
-            t.k0,
-            t.added,
-            refit,
-        );
-        out.push(Some((c, fitted)));
     }
-    Ok(out)
+    Ok(best
+        .into_iter()
+        .map(|b| {
+            b.map(|(fitted, refit, t)| {
+                let c = Candidate::scored(
+                    t.effect.name(),
+                    round,
+                    fits.inputs,
+                    model,
+                    &fitted,
+                    t.k0,
+                    t.added,
+                    refit,
+                );
+                (c, fitted)
+            })
+        })
+        .collect())
 }
 
-/// `effect` added to `model` at its best start (renders counted in
-/// `fits`), or None when it does not apply.
-fn prepare(fits: &mut Refits, model: &Model, effect: &'static dyn Effect) -> Result<Option<Trial>> {
-    let Some(ext) = effects::extend(effect, &model.scene) else {
-        return Ok(None);
-    };
+/// `effect` added to `model` in each of its forms, each at its best start
+/// (renders counted in `fits`); empty when it does not apply.
+fn prepare(fits: &mut Refits, model: &Model, effect: &'static dyn Effect) -> Result<Vec<Trial>> {
     let k0 = ParamSpace::from_scene(&model.scene).dim();
-    let added = ParamSpace::from_scene(&ext.scene).dim() - k0;
-    let (start, count) = starts::best_start(fits.renderer(), &ext, fits.inputs)?;
-    fits.renders += count;
-    let trades = effect.trades();
-    Ok(Some(Trial {
-        effect,
-        search: trades.search(&start, &ext.added),
-        radius: trades.radius,
-        start,
-        k0,
-        added,
-    }))
+    let mut trials = Vec::new();
+    for ext in effects::forms(effect, &model.scene) {
+        let added = ParamSpace::from_scene(&ext.scene).dim() - k0;
+        let (start, count) = starts::best_start(fits.renderer(), &ext, fits.inputs)?;
+        fits.renders += count;
+        let trades = effect.trades();
+        trials.push(Trial {
+            effect,
+            search: trades.search(&start, &ext.added),
+            radius: trades.radius,
+            start,
+            k0,
+            added,
+        });
+    }
+    Ok(trials)
 }

@@ -231,13 +231,13 @@ impl SetRefits<'_> {
             return Ok((ext.scene.clone(), own.to_vec()));
         }
         let inputs = self.inputs;
-        let levels = |images: &[&Image]| -> Vec<(f64, f64)> {
+        let levels = |images: &[&Image], scale| -> Vec<(f64, f64)> {
             images
                 .iter()
                 .zip(&inputs.shots)
                 .map(|(img, s)| {
                     let w = crate::fit::set::counted(&s.target) as f64;
-                    (w, super::starts::level(img, s.target.mask.as_ref()))
+                    (w, super::starts::level(img, s.target.mask.as_ref(), scale))
                 })
                 .collect()
         };
@@ -246,9 +246,10 @@ impl SetRefits<'_> {
             l.iter().map(|x| x.0 * x.1).sum::<f64>() / n.max(1.0)
         };
         let targets: Vec<&Image> = inputs.shots.iter().map(|s| &s.target.image).collect();
-        let want = levels(&targets);
         let mut best = (f64::INFINITY, ext.scene.clone(), own.to_vec());
         for start in std::iter::once(&ext.scene).chain(&ext.starts) {
+            let scale = super::starts::Scale::of(start);
+            let want = levels(&targets, scale);
             let shots = shots_of(start, inputs, own)?;
             let Some((images, d)) = self.render(&shots)? else {
                 continue;
@@ -256,7 +257,7 @@ impl SetRefits<'_> {
             if d < best.0 {
                 best = (d, start.clone(), own.to_vec());
             }
-            let have = levels(&images.iter().collect::<Vec<_>>());
+            let have = levels(&images.iter().collect::<Vec<_>>(), scale);
             if pooled(&have) <= 0.0 {
                 continue;
             }
@@ -479,14 +480,30 @@ fn rounds(
         let searched: Vec<&dyn Effect> =
             open.iter().copied().filter(|e| !e.closed_form()).collect();
         let current = &*model;
-        let refitted = super::lanes::side_by_side(fits, &searched, |f, &effect| {
-            let Some(ext) = effects::extend(effect, &current.scene) else {
-                return Ok(None);
-            };
-            let (start, own) = f.best_start(&ext, &current.own)?;
-            f.run(&start, &own).map(Some)
+        // Every form of every searched effect, refitted side by side; each
+        // effect's best form counts.
+        let forms: Vec<(usize, effects::Extension)> = searched
+            .iter()
+            .enumerate()
+            .flat_map(|(i, &e)| {
+                effects::forms(e, &current.scene)
+                    .into_iter()
+                    .map(move |x| (i, x))
+            })
+            .collect();
+        let done = super::lanes::side_by_side(fits, &forms, |f, (_, ext)| {
+            let (start, own) = f.best_start(ext, &current.own)?;
+            f.run(&start, &own)
         });
-        let mut refitted = refitted.into_iter();
+        let mut best: Vec<Option<SetModel>> = searched.iter().map(|_| None).collect();
+        for ((i, _), fitted) in forms.iter().zip(done) {
+            let fitted = fitted?;
+            best[*i] = Some(match best[*i].take() {
+                Some(b) => b.better(fitted),
+                None => fitted,
+            });
+        }
+        let mut refitted = best.into_iter();
         let mut tried: Vec<(Candidate, SetModel)> = Vec::new();
         for effect in open {
             let (fitted, k) = if effect.closed_form() {
@@ -500,7 +517,7 @@ fn rounds(
                 let k = fitted.dim(inputs) + values;
                 (fitted, k)
             } else {
-                let Some(fitted) = refitted.next().expect("one result per searched effect")? else {
+                let Some(fitted) = refitted.next().expect("one result per searched effect") else {
                     continue;
                 };
                 let k = fitted.dim(inputs);

@@ -12,7 +12,9 @@
 //! Each 8-bit sRGB pixel is decoded to linear v, then
 //! `v * (1 - strength * r^2)` (r: distance from the image centre over the
 //! half-diagonal), times exposure and the channel's white balance, then
-//! `black + gain * v^gamma`, then sRGB-encoded again.
+//! `black + gain * v^gamma`, then sRGB-encoded again, or, for a response
+//! whose `encoding` is `linear`, written as a fraction of level 255 as it
+//! is (a camera that stores linear values).
 //! A scene without these fields passes through untouched.
 
 #[cfg(test)]
@@ -20,7 +22,7 @@ use super::srgb::encode;
 use super::srgb::{decode, encode_exact};
 use super::{Image, RenderResult, RenderSession, Renderer};
 use crate::error::Result;
-use crate::scene::{Camera, ParamSpace, Scene};
+use crate::scene::{Camera, ParamSpace, ResponseEncoding, Scene};
 
 /// Any renderer, followed by the camera's image-space effects.
 pub struct WithCameraEffects(pub Box<dyn Renderer>);
@@ -81,9 +83,20 @@ pub fn has_effects(cam: &Camera) -> bool {
     cam.vignetting.is_some_and(|v| v.strength != 0.0)
         || cam.exposure.is_some_and(|e| e != 1.0)
         || cam.white_balance.is_some_and(|wb| wb != [1.0; 3])
-        || cam
-            .response
-            .is_some_and(|r| r.gain != 1.0 || r.gamma != 1.0 || r.black != 0.0)
+        || cam.response.is_some_and(|r| {
+            r.gain != 1.0
+                || r.gamma != 1.0
+                || r.black != 0.0
+                || r.encoding == ResponseEncoding::Linear
+        })
+}
+
+/// The 8-bit level the response writes for the curve's output `x`.
+fn writer(encoding: ResponseEncoding) -> fn(f64) -> u8 {
+    match encoding {
+        ResponseEncoding::Srgb => encode_exact,
+        ResponseEncoding::Linear => |x| (x.clamp(0.0, 1.0) * 255.0).round() as u8,
+    }
 }
 
 /// Applies the camera's vignetting and response to `img` in place.
@@ -103,7 +116,8 @@ pub fn apply(cam: &Camera, img: &mut Image) {
         // input alone: a table per channel instead of two powers per value
         // (the difference between ~600 and ~6,000 renders/s at 128x96).
         let lut = decoded();
-        let curve = |v: f64| encode_exact(resp.black + resp.gain * v.max(0.0).powf(resp.gamma));
+        let write = writer(resp.encoding);
+        let curve = |v: f64| write(resp.black + resp.gain * v.max(0.0).powf(resp.gamma));
         let tables = balance.map(|b| -> [u8; 256] { std::array::from_fn(|i| curve(lut[i] * b)) });
         for px in img.pixels_mut() {
             for (c, t) in px.0.iter_mut().zip(&tables) {
@@ -115,6 +129,7 @@ pub fn apply(cam: &Camera, img: &mut Image) {
     // With it, (v b f)^gamma = (v b)^gamma f^gamma: a table per channel and
     // 8-bit input, and one power per pixel (none at gamma 1).
     let powered = balance.map(|b| powered(b, resp.gamma));
+    let write = writer(resp.encoding);
     for (x, y, px) in img.enumerate_pixels_mut() {
         let (dx, dy) = (x as f64 + 0.5 - cx, y as f64 + 0.5 - cy);
         let fall = (1.0 - k * (dx * dx + dy * dy) / half_diag2).max(0.0);
@@ -124,7 +139,7 @@ pub fn apply(cam: &Camera, img: &mut Image) {
             fall.powf(resp.gamma)
         };
         for (c, table) in px.0.iter_mut().zip(&powered) {
-            *c = encode_exact(resp.black + resp.gain * table[*c as usize] * bent);
+            *c = write(resp.black + resp.gain * table[*c as usize] * bent);
         }
     }
 }
@@ -203,11 +218,32 @@ mod tests {
         let mut cam = camera();
         cam.response = Some(Response {
             gain: 0.5,
-            gamma: 1.0,
-            black: 0.0,
+            ..Response::default()
         });
         let mut img = Image::from_pixel(2, 2, image::Rgb([188, 188, 188]));
         apply(&cam, &mut img);
         assert_eq!(img.get_pixel(0, 0)[0], encode(decode(188) * 0.5));
+    }
+
+    #[test]
+    fn a_linear_response_writes_linear_levels() {
+        let mut cam = camera();
+        cam.response = Some(Response {
+            encoding: ResponseEncoding::Linear,
+            ..Response::default()
+        });
+        // sRGB level 188 is linear 0.5029: level 128 when written as is.
+        let mut img = Image::from_pixel(2, 2, image::Rgb([188, 0, 255]));
+        apply(&cam, &mut img);
+        assert_eq!(img.get_pixel(1, 1).0, [128, 0, 255]);
+        // A black level below 0 is subtracted and clips at 0.
+        cam.response = Some(Response {
+            black: -0.01,
+            encoding: ResponseEncoding::Linear,
+            ..Response::default()
+        });
+        let mut img = Image::from_pixel(1, 1, image::Rgb([188, 10, 255]));
+        apply(&cam, &mut img);
+        assert_eq!(img.get_pixel(0, 0).0, [125, 0, 252]);
     }
 }

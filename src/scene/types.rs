@@ -80,7 +80,8 @@ pub struct Vignetting {
     pub strength: f64,
 }
 
-/// v -> black + gain * v^gamma on linear values, before sRGB encoding.
+/// v -> black + gain * v^gamma on linear values, then written to the
+/// image as `encoding` says.
 #[derive(Clone, Copy, Debug, Serialize, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct Response {
@@ -88,8 +89,31 @@ pub struct Response {
     pub gain: f64,
     #[serde(default = "one")]
     pub gamma: f64,
+    /// Added after the curve; below 0 it is a black level subtracted (the
+    /// result clipped at 0).
     #[serde(default)]
     pub black: f64,
+    /// How the camera writes the curve's output into the file.
+    #[serde(default, skip_serializing_if = "ResponseEncoding::is_srgb")]
+    pub encoding: ResponseEncoding,
+}
+
+/// `srgb`: the curve's output is light, stored through the sRGB transfer
+/// function (a camera's JPEG); `linear`: the output is stored as is, a
+/// fraction of the file's maximum (a raw converter's linear output, many
+/// photometric-stereo and light-stage data sets).
+#[derive(Clone, Copy, Debug, Default, Serialize, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "lowercase")]
+pub enum ResponseEncoding {
+    #[default]
+    Srgb,
+    Linear,
+}
+
+impl ResponseEncoding {
+    fn is_srgb(&self) -> bool {
+        *self == ResponseEncoding::Srgb
+    }
 }
 
 impl Default for Response {
@@ -98,6 +122,7 @@ impl Default for Response {
             gain: 1.0,
             gamma: 1.0,
             black: 0.0,
+            encoding: ResponseEncoding::Srgb,
         }
     }
 }

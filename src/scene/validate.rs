@@ -618,6 +618,8 @@ fn physical_minimum(field: &Field, f: &FreeParam, lo: f64, file: &str, at: &str)
             | super::field::CameraField::Exposure,
         )
         | Field::Shape(..) => f64::MIN_POSITIVE,
+        // A black level below 0 is one subtracted (clipped at 0).
+        Field::Camera(super::field::CameraField::ResponseBlack) => f64::NEG_INFINITY,
         _ => 0.0,
     };
     if lo < physical_min {

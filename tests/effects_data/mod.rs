@@ -92,6 +92,7 @@ pub fn plant(truth: &mut Scene, effect: &str, strength: f64) {
                 gain: 1.0 + 0.2 * strength,
                 gamma: 1.0 - 0.3 * strength,
                 black: 0.0,
+                ..Default::default()
             })
         }
         "indirect_light" => truth.indirect_light = Some(3.0 * strength),

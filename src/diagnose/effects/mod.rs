@@ -44,6 +44,16 @@ pub trait Effect: Sync {
         Vec::new()
     }
 
+    /// Other forms of the effect that none of its numbers moves between,
+    /// each built from `extended` (the neutral form): the camera's response
+    /// written as linear values besides through the sRGB curve. Each form
+    /// is refitted from its own best start and the best refit counts, so a
+    /// form that starts further from the target but ends closer is not
+    /// lost to the start's comparison.
+    fn variants(&self, _extended: &Scene) -> Vec<Scene> {
+        Vec::new()
+    }
+
     /// What its own parameters are searched with: the fitted parameters it
     /// trades with, and how far from the start the search spreads.
     fn trades(&self) -> Trades {
@@ -115,6 +125,27 @@ pub fn extend(effect: &dyn Effect, scene: &Scene) -> Option<Extension> {
         added,
         starts,
     })
+}
+
+/// Every form of `effect` added to `scene` (the neutral one first, then
+/// its [`Effect::variants`]), each with its own starts; empty when it does
+/// not apply.
+pub fn forms(effect: &dyn Effect, scene: &Scene) -> Vec<Extension> {
+    let Some(neutral) = extend(effect, scene) else {
+        return Vec::new();
+    };
+    let variants = effect.variants(&neutral.scene);
+    let added = neutral.added.clone();
+    let mut out = vec![neutral];
+    for scene in variants {
+        let starts = effect.starts(&scene, &added);
+        out.push(Extension {
+            scene,
+            added: added.clone(),
+            starts,
+        });
+    }
+    out
 }
 
 #[cfg(test)]
