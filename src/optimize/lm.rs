@@ -129,12 +129,16 @@ fn residual_scale(r: &[f32]) -> f64 {
 }
 
 /// The Levenberg–Marquardt step `δ` solving
-/// `(A + λ (diag A + ε)) δ = −g` over the coordinates marked `free` (the
-/// others stay 0). `ε`, a tiny fraction of the largest diagonal entry,
-/// keeps a coordinate the image ignores from making the system singular.
-/// `None` when the system cannot be solved (non-finite input).
-pub fn damped_step(normal: &Normal, lambda: f64, free: &[bool]) -> Option<Vec<f64>> {
-    let index: Vec<usize> = (0..normal.g.len()).filter(|&j| free[j]).collect();
+/// `(A + λ (diag A + ε)) δ = −g` over the coordinates not `fixed` (a fixed
+/// coordinate's step is the value given, and its coupling to the others
+/// moves to the right-hand side). `ε`, a tiny fraction of the largest
+/// diagonal entry, keeps a coordinate the image ignores from making the
+/// system singular. `None` when the system cannot be solved (non-finite
+/// input).
+pub fn damped_step(normal: &Normal, lambda: f64, fixed: &[Option<f64>]) -> Option<Vec<f64>> {
+    let index: Vec<usize> = (0..normal.g.len())
+        .filter(|&j| fixed[j].is_none())
+        .collect();
     let largest = index.iter().map(|&j| normal.a[j][j]).fold(0.0, f64::max);
     let epsilon = (largest * 1e-9).max(1e-12);
     let matrix: Vec<Vec<f64>> = index
@@ -153,9 +157,17 @@ pub fn damped_step(normal: &Normal, lambda: f64, free: &[bool]) -> Option<Vec<f6
                 .collect()
         })
         .collect();
-    let rhs: Vec<f64> = index.iter().map(|&j| -normal.g[j]).collect();
+    let rhs: Vec<f64> = index
+        .iter()
+        .map(|&j| {
+            let coupled: f64 = (0..fixed.len())
+                .filter_map(|k| fixed[k].map(|d| normal.a[j][k] * d))
+                .sum();
+            -normal.g[j] - coupled
+        })
+        .collect();
     let solved = cholesky_solve(&matrix, &rhs)?;
-    let mut step = vec![0.0; normal.g.len()];
+    let mut step: Vec<f64> = fixed.iter().map(|f| f.unwrap_or(0.0)).collect();
     for (&j, v) in index.iter().zip(solved) {
         step[j] = v;
     }
@@ -262,18 +274,31 @@ impl Change {
     }
 }
 
-/// The damped step's end point from `x` in the unit cube: coordinates on a
-/// face whose step would leave the cube are held, and the rest clamped.
-/// None when it does not move or the system cannot be solved.
+/// The damped step's end point from `x` in the unit cube, by an active
+/// set: a coordinate whose step would leave the cube is pinned at the face
+/// it crosses and the others are solved again with it held there, until
+/// no new coordinate is pinned. Clamping each coordinate alone instead
+/// bends the step off the direction the model chose; on a ridge, where
+/// the step is long and the coordinates trade, that lands the trial far
+/// from the model's minimum on the face. None when it does not move or
+/// the system cannot be solved.
 pub fn bounded_trial(normal: &Normal, lambda: f64, x: &[f64]) -> Option<Vec<f64>> {
-    let mut free = vec![true; x.len()];
-    let mut step = damped_step(normal, lambda, &free)?;
-    let blocked = |x: f64, s: f64| (x <= 0.0 && s < 0.0) || (x >= 1.0 && s > 0.0);
-    if x.iter().zip(&step).any(|(&x, &s)| blocked(x, s)) {
-        for (j, f) in free.iter_mut().enumerate() {
-            *f = !blocked(x[j], step[j]);
+    let mut fixed: Vec<Option<f64>> = vec![None; x.len()];
+    let mut step = damped_step(normal, lambda, &fixed)?;
+    // Each pass pins at least one more coordinate, so this ends.
+    loop {
+        let mut pinned = false;
+        for j in 0..x.len() {
+            if fixed[j].is_none() && !(0.0..=1.0).contains(&(x[j] + step[j])) {
+                let face = if x[j] + step[j] < 0.0 { 0.0 } else { 1.0 };
+                fixed[j] = Some(face - x[j]);
+                pinned = true;
+            }
         }
-        step = damped_step(normal, lambda, &free)?;
+        if !pinned || fixed.iter().all(Option::is_some) {
+            break;
+        }
+        step = damped_step(normal, lambda, &fixed)?;
     }
     let trial: Vec<f64> = x
         .iter()
@@ -317,9 +342,9 @@ mod tests {
                 },
             ],
         );
-        let step = damped_step(&normal, 1e-12, &[true, true]).expect("solvable");
+        let step = damped_step(&normal, 1e-12, &[None, None]).expect("solvable");
         assert!((step[0] - 2.0).abs() < 1e-6 && (step[1] + 2.0).abs() < 1e-6);
-        let only_first = damped_step(&normal, 1e-12, &[true, false]).expect("solvable");
+        let only_first = damped_step(&normal, 1e-12, &[None, Some(0.0)]).expect("solvable");
         assert_eq!(only_first[1], 0.0);
     }
 
