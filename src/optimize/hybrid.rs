@@ -372,12 +372,14 @@ impl Hybrid {
         self.generation += 1;
         // A trial better than the best counts at once: the target may be
         // reached before its Jacobian is rendered.
-        if let Some((point, fitness)) = local.trial(evaluations) {
-            let point = point.to_vec();
-            self.observe(&point, fitness);
+        let trial = local.trial(evaluations).map(|(p, f)| (p.to_vec(), f));
+        if let Some((point, fitness)) = &trial {
+            self.observe(point, *fitness);
         }
         let going = local.tell(evaluations);
-        if let Some(normal) = &local.normal {
+        // The normal equations belong to the run's point only after a
+        // Jacobian batch.
+        if let (Some(normal), None) = (&local.normal, &trial) {
             if self.observe(&local.x, local.fitness) || local.x == self.best {
                 self.at_best = Some(normal.clone());
             }

@@ -203,6 +203,12 @@ impl Local {
     /// Accepts or rejects the trial; an accepted one's Jacobian is asked
     /// for next.
     fn tell_trial(&mut self, fitness: f64) -> bool {
+        if fitness == 0.0 && self.fitness > 0.0 {
+            // Nothing is left to gain: no Jacobian is worth its renders.
+            self.x = self.batch[0].clone();
+            self.fitness = 0.0;
+            return false;
+        }
         if fitness < self.fitness {
             let gain = (self.fitness - fitness) / self.fitness;
             self.stalled = if gain > GAIN_TOLERANCE {
