@@ -1,15 +1,15 @@
 //! One Levenberg–Marquardt run of the hybrid search ([`Local`]): from a
 //! starting point, damped Gauss–Newton steps on the per-value residuals
-//! with a forward-difference Jacobian, until the run stalls or the global
-//! phase would gain more per render.
+//! with a second-order difference Jacobian, until the run stalls or the
+//! global phase would gain more per render.
 //!
-//! **Two kinds of batch.** A Jacobian batch is a point and its P
-//! neighbours, one per coordinate moved by that coordinate's difference
-//! step; a trial batch is the one point the damped step proposes. The
+//! **Two kinds of batch.** A Jacobian batch is a point and its 2P
+//! neighbours, two per coordinate moved by that coordinate's difference
+//! step (`lm::second_order` says why two); a trial batch is the one point the damped step proposes. The
 //! Jacobian of a trial is asked for only once the trial has been accepted
 //! (with the trial rendered again as the batch's centre, so that the
 //! differences share its sampler seed and no residual vector has to be
-//! kept between batches): a rejected trial costs one render, not P+1. On
+//! kept between batches): a rejected trial costs one render, not 2P+1. On
 //! a ridge, where the model is good along some directions and poor along
 //! others, about half of the trials are rejected.
 //!
