@@ -6,7 +6,7 @@
 //!
 //! Why: DE spends most of its renders on the last digits, where the
 //! objective is smooth and a Gauss–Newton step with a finite-difference
-//! Jacobian (P+1 renders) does what many DE generations would; a local
+//! Jacobian (2P+1 renders) does what many DE generations would; a local
 //! method alone, though, sticks in whatever basin it starts in, and on
 //! 8-bit images it stalls once the remaining differences are a few levels
 //! on a few values, where the population still finds its way down.
@@ -25,30 +25,23 @@
 //! waiting for the spread alone meant waiting for the last coordinate the
 //! image barely sees, thousands of renders.
 //!
-//! **Local phase.** Each step asks for one batch of P+1 points: the trial
-//! point and, per coordinate, the trial moved by that coordinate's
-//! difference step. If the trial improves the fitness it becomes the
-//! current point and its Jacobian is already known; if not, the damping
-//! grows and the batch is redone from the current point's Jacobian (the P
-//! differences of a rejected trial are the price of asking for one batch
-//! per step, which keeps the executor's parallelism). The normal equations
+//! **Local phase** ([`Local`], `local.rs`). A trial is asked for alone
+//! and its Jacobian (second-order differences: 2P+1 renders) only once it
+//! is accepted, so a rejected trial costs one render. The normal equations
 //! are reweighted (IRLS) so the steps minimise the L1 deviation the fit
-//! reports, and acceptance compares that same fitness. Bounds: a
-//! coordinate on a face whose step points out of the cube is held fixed for
-//! that step, the rest is projected into the cube; differences at the upper
-//! face are taken backwards. Difference steps adapt per coordinate from the
-//! change they produce (`lm::adapt_step`), since the images are 8-bit, and
-//! carry over from one local run to the next.
+//! reports, and acceptance compares that same fitness. Bounds by an
+//! active set (`lm::bounded_trial`). Difference steps adapt per coordinate
+//! from the change they produce (`lm::adapt_step`), since the images are
+//! 8-bit, and carry over from one local run to the next.
 //!
-//! **Back to the global phase.** A local run ends when its last
-//! [`RATE_WINDOW`] steps lowered the log fitness per render less than the
-//! global phase did over its last stint (the population would do better),
-//! after [`STALL_STEPS`] steps in a row without a relative gain of
-//! [`GAIN_TOLERANCE`], or when the damping passes [`LAMBDA_MAX`]. Its point
-//! then replaces the worst population member and SHADE goes on. The run
-//! ends by the executor's budget or target; [`Search::converged`] is true
-//! only when nothing can move any more: the fitness is 0, or a local run
-//! gained nothing and the population has collapsed onto one point.
+//! **Back to the global phase.** A local run ends when its last few steps
+//! lowered the log fitness per render less than the global phase did over
+//! its last stint (the population would do better), or when it stalls
+//! (see `local.rs`). Its point then replaces the worst population member
+//! and SHADE goes on. The run ends by the executor's budget or target;
+//! [`Search::converged`] is true only when nothing can move any more: the
+//! fitness is 0, or a local run gained nothing and the population has
+//! collapsed onto one point.
 //!
 //! **Settling** ([`Hybrid::settle`], for refits that need an answer, not
 //! a budget spent): the run also ends once both phases agree they are done
@@ -73,7 +66,8 @@
 use serde::{Deserialize, Serialize};
 
 use super::identifiability::Identifiability;
-use super::lm::{self, Column, Normal};
+use super::lm::Normal;
+use super::local::Local;
 use super::{exact, De, DeConfig, Evaluation, Progress, Request, Search, Strategy};
 
 /// Hand over when the largest per-coordinate spread is below
@@ -88,14 +82,6 @@ pub const HANDOVER_SPREAD: f64 = 0.1;
 /// SHADE generations after which a local run is tried even if the spread
 /// test has not handed over.
 pub const TRIAL_EVERY: usize = 10;
-/// Local steps over which the local rate of progress is measured.
-pub const RATE_WINDOW: usize = 3;
-/// A step must lower the fitness by this fraction to count as progress.
-pub const GAIN_TOLERANCE: f64 = 1e-5;
-/// Steps in a row without progress that end a local run.
-pub const STALL_STEPS: usize = 3;
-/// Damping beyond which the step is too short to matter.
-pub const LAMBDA_MAX: f64 = 1e8;
 /// A local run from a population member other than the best starts only
 /// this far (max-norm, unit cube) from every earlier start and end.
 pub const START_SEPARATION: f64 = 0.05;
@@ -108,10 +94,6 @@ pub const SETTLE_TRIES: usize = 2;
 /// Largest per-coordinate spread of a population collapsed onto one point.
 const COLLAPSED: f64 = 1e-12;
 
-const LAMBDA_START: f64 = 1e-3;
-const LAMBDA_MIN: f64 = 1e-9;
-const LAMBDA_DOWN: f64 = 1.0 / 3.0;
-const LAMBDA_UP: f64 = 8.0;
 const STEP_START: f64 = 0.01;
 
 /// SHADE handing over to Levenberg–Marquardt and back; see the module docs.
@@ -173,162 +155,6 @@ enum Phase {
     Global,
     Local(Local),
     Done,
-}
-
-/// One Levenberg–Marquardt run.
-#[derive(Clone, Debug, Serialize, Deserialize)]
-struct Local {
-    /// The accepted point.
-    #[serde(with = "exact::vector")]
-    x: Vec<f64>,
-    /// Its fitness (+inf until its batch has been told).
-    #[serde(with = "exact::scalar")]
-    fitness: f64,
-    /// The fitness it started from.
-    #[serde(with = "exact::scalar")]
-    start_fitness: f64,
-    /// Its normal equations (None until its batch has been told).
-    normal: Option<Normal>,
-    #[serde(with = "exact::scalar")]
-    lambda: f64,
-    /// Difference step per coordinate (unsigned).
-    #[serde(with = "exact::vector")]
-    steps: Vec<f64>,
-    /// The batch asked for: trial first, then one neighbour per coordinate.
-    #[serde(with = "exact::matrix")]
-    batch: Vec<Vec<f64>>,
-    stalled: usize,
-    /// The accepted fitness after each step, oldest first, the last
-    /// [`RATE_WINDOW`] + 1 of them.
-    #[serde(with = "exact::vector")]
-    history: Vec<f64>,
-    /// The global phase's log fitness lowered per render, which the run
-    /// must beat to go on.
-    #[serde(with = "exact::scalar")]
-    rate_floor: f64,
-    /// Set when the run ended because the global phase was faster.
-    outpaced: bool,
-    /// Whether it started from the global best after a global stint that
-    /// gained less than [`SETTLED_GAIN`] (the global phase is done there).
-    #[serde(default)]
-    global_done: bool,
-}
-
-impl Local {
-    fn start(x: Vec<f64>, steps: Vec<f64>, rate_floor: f64, global_done: bool) -> Local {
-        let batch = neighbourhood(&x, &steps);
-        Local {
-            x,
-            fitness: f64::INFINITY,
-            start_fitness: f64::INFINITY,
-            normal: None,
-            lambda: LAMBDA_START,
-            steps,
-            batch,
-            stalled: 0,
-            history: Vec::new(),
-            rate_floor,
-            outpaced: false,
-            global_done,
-        }
-    }
-
-    /// Takes the evaluations of `batch`; returns false when the run ended.
-    fn tell(&mut self, evaluations: &[Evaluation]) -> bool {
-        let trial = self.batch[0].clone();
-        let center = &evaluations[0];
-        let normal = center.residuals.as_deref().map(|r| {
-            let columns: Vec<Column> = (0..self.x.len())
-                .map(|j| Column {
-                    residuals: evaluations[j + 1].residuals.as_deref(),
-                    step: self.batch[j + 1][j] - trial[j],
-                })
-                .collect();
-            lm::normal_equations(r, &columns)
-        });
-        if let Some(r) = center.residuals.as_deref() {
-            for (j, step) in self.steps.iter_mut().enumerate() {
-                *step = lm::adapt_step(*step, r, evaluations[j + 1].residuals.as_deref());
-            }
-        }
-        let fitness = if center.fitness.is_finite() {
-            center.fitness
-        } else {
-            f64::INFINITY
-        };
-        let first = self.normal.is_none();
-        if first {
-            // The starting point itself: nothing to compare with yet.
-            self.fitness = fitness;
-            self.start_fitness = fitness;
-            self.normal = normal;
-            if self.normal.is_none() {
-                return false;
-            }
-        } else if fitness < self.fitness && normal.is_some() {
-            let gain = (self.fitness - fitness) / self.fitness;
-            self.stalled = if gain > GAIN_TOLERANCE {
-                0
-            } else {
-                self.stalled + 1
-            };
-            self.x = trial;
-            self.fitness = fitness;
-            self.normal = normal;
-            self.lambda = (self.lambda * LAMBDA_DOWN).max(LAMBDA_MIN);
-        } else {
-            self.stalled += 1;
-            self.lambda *= LAMBDA_UP;
-        }
-        self.history.push(self.fitness);
-        if self.history.len() > RATE_WINDOW + 1 {
-            self.history.remove(0);
-        }
-        if self.fitness == 0.0 || self.stalled >= STALL_STEPS || self.lambda > LAMBDA_MAX {
-            return false;
-        }
-        if self.slower_than_global() {
-            self.outpaced = true;
-            return false;
-        }
-        match self.next_trial() {
-            Some(next) => {
-                self.batch = neighbourhood(&next, &self.steps);
-                true
-            }
-            None => false,
-        }
-    }
-
-    /// Whether the last [`RATE_WINDOW`] steps lowered the log fitness per
-    /// render less than the global phase did.
-    fn slower_than_global(&self) -> bool {
-        if self.history.len() <= RATE_WINDOW {
-            return false;
-        }
-        let renders = (RATE_WINDOW * (self.x.len() + 1)) as f64;
-        let rate = (self.history[0] / self.fitness).ln() / renders;
-        rate < self.rate_floor
-    }
-
-    /// The damped step from `x`, with coordinates on a face whose step
-    /// would leave the cube held fixed; None when it does not move.
-    fn next_trial(&self) -> Option<Vec<f64>> {
-        lm::bounded_trial(self.normal.as_ref()?, self.lambda, &self.x)
-    }
-}
-
-/// `x` followed by `x` moved along each axis by its step (backwards where
-/// forwards would leave the cube).
-fn neighbourhood(x: &[f64], steps: &[f64]) -> Vec<Vec<f64>> {
-    let mut batch = Vec::with_capacity(x.len() + 1);
-    batch.push(x.to_vec());
-    for (j, &h) in steps.iter().enumerate() {
-        let mut moved = x.to_vec();
-        moved[j] = if x[j] + h <= 1.0 { x[j] + h } else { x[j] - h };
-        batch.push(moved);
-    }
-    batch
 }
 
 /// The per-coordinate standard deviations of the better half of
@@ -544,8 +370,16 @@ impl Hybrid {
 
     fn tell_local(&mut self, mut local: Local, evaluations: &[Evaluation]) {
         self.generation += 1;
+        // A trial better than the best counts at once: the target may be
+        // reached before its Jacobian is rendered.
+        let trial = local.trial(evaluations).map(|(p, f)| (p.to_vec(), f));
+        if let Some((point, fitness)) = &trial {
+            self.observe(point, *fitness);
+        }
         let going = local.tell(evaluations);
-        if let Some(normal) = &local.normal {
+        // The normal equations belong to the run's point only after a
+        // Jacobian batch.
+        if let (Some(normal), None) = (&local.normal, &trial) {
             if self.observe(&local.x, local.fitness) || local.x == self.best {
                 self.at_best = Some(normal.clone());
             }
@@ -606,11 +440,7 @@ impl Hybrid {
             && self.starts.iter().chain(&self.ends).all(|s| s.len() == dim)
             && self.at_best.as_ref().is_none_or(normal_ok);
         if let Phase::Local(local) = &self.phase {
-            ok &= local.x.len() == dim
-                && local.steps.len() == dim
-                && local.batch.len() == dim + 1
-                && local.batch.iter().all(|p| p.len() == dim)
-                && local.normal.as_ref().is_none_or(normal_ok);
+            ok &= local.fits(dim) && local.normal.as_ref().is_none_or(normal_ok);
         }
         if ok {
             Ok(())
@@ -625,7 +455,7 @@ impl Search for Hybrid {
         match &mut self.phase {
             Phase::Global => Search::ask(&mut self.global),
             Phase::Local(local) => Request {
-                points: local.batch.clone(),
+                points: local.batch().to_vec(),
                 residuals: true,
             },
             // Nothing left to try; an executor that asks anyway gets the
@@ -642,7 +472,7 @@ impl Search for Hybrid {
     fn tell(&mut self, evaluations: &[Evaluation]) {
         let expected = match &self.phase {
             Phase::Global => self.global.population().len(),
-            Phase::Local(local) => local.batch.len(),
+            Phase::Local(local) => local.batch().len(),
             Phase::Done => 1,
         };
         assert_eq!(

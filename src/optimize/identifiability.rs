@@ -74,6 +74,7 @@ mod tests {
             g: vec![0.0; 3],
             jtj: vec![vec![4.0, 0.0, 0.0], vec![0.0, 1.0, 0.0], vec![0.0; 3]],
             scale: 2.0,
+            wrr: 0.0,
         };
         let id = Identifiability::from_normal(&normal).expect("solvable");
         assert!((id.std_error[0] - 1.0).abs() < 1e-12);
@@ -90,6 +91,7 @@ mod tests {
             g: vec![0.0; 2],
             jtj: vec![vec![2.0, 1.0], vec![1.0, 2.0]],
             scale: 1.0,
+            wrr: 0.0,
         };
         let id = Identifiability::from_normal(&normal).expect("solvable");
         // (JᵀJ)⁻¹ = [[2, -1], [-1, 2]] / 3: correlation -1/2.

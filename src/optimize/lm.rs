@@ -57,6 +57,10 @@ pub struct Normal {
     /// Robust standard deviation of one residual, in levels.
     #[serde(with = "exact::scalar")]
     pub scale: f64,
+    /// `rᵀ W r`: the L1 sum the weights make the quadratic model equal at
+    /// the point, for the gain a step predicts.
+    #[serde(with = "exact::scalar", default)]
+    pub wrr: f64,
 }
 
 /// One Jacobian column from a forward difference: the perturbed point's
@@ -65,6 +69,34 @@ pub struct Normal {
 pub struct Column<'a> {
     pub residuals: Option<&'a [f32]>,
     pub step: f64,
+}
+
+/// One Jacobian column from the quadratic through the point (residuals
+/// `r`) and two neighbours along the coordinate, `a` at signed offset
+/// `first` and `b` at `second`: a central difference when they lie on
+/// either side, a one-sided second-order difference when both lie on one
+/// side (at a face of the cube). Returned as the residuals a forward
+/// difference of `first` would have seen, for [`Column`]. Why: a forward
+/// difference is off by half the second derivative times the step, and on
+/// 8-bit images the step must be large enough to change values by whole
+/// levels; there that term is what turns the Jacobian into a secant that
+/// sees only one wall of a narrow valley. A quadratic's slope is off by a
+/// third-order term only.
+pub fn second_order(r: &[f32], a: &[f32], first: f64, b: &[f32], second: f64) -> Vec<f32> {
+    let (s, t) = (first, second);
+    // d = r + s·J, J the slope at 0 of the quadratic through the nodes
+    // 0, s and t.
+    let ca = t / (t - s);
+    let cb = -s * s / (t * (t - s));
+    let cr = -(s + t) / t;
+    r.iter()
+        .zip(a)
+        .zip(b)
+        .map(|((&r, &a), &b)| {
+            let (r, a, b) = (f64::from(r), f64::from(a), f64::from(b));
+            (r + ca * a + cb * b + cr * r) as f32
+        })
+        .collect()
 }
 
 /// Builds the normal equations at a point with residuals `r` from its
@@ -77,6 +109,7 @@ pub fn normal_equations(r: &[f32], columns: &[Column]) -> Normal {
     let mut a = vec![vec![0.0; p]; p];
     let mut jtj = vec![vec![0.0; p]; p];
     let mut g = vec![0.0; p];
+    let mut wrr = 0.0;
     let usable: Vec<bool> = columns
         .iter()
         .map(|c| c.residuals.is_some_and(|d| d.len() == r.len()) && c.step != 0.0)
@@ -91,6 +124,7 @@ pub fn normal_equations(r: &[f32], columns: &[Column]) -> Normal {
             };
         }
         let w = 1.0 / ri.abs().max(WEIGHT_FLOOR);
+        wrr += w * ri * ri;
         for j in 0..p {
             if row[j] == 0.0 {
                 continue;
@@ -113,6 +147,23 @@ pub fn normal_equations(r: &[f32], columns: &[Column]) -> Normal {
         g,
         jtj,
         scale: residual_scale(r),
+        wrr,
+    }
+}
+
+/// The relative decrease of the reweighted sum the model predicts for the
+/// step from `x` to `trial`: `(−gᵀδ − ½ δᵀAδ) / rᵀWr` (0 when unknown).
+pub fn predicted_gain(normal: &Normal, x: &[f64], trial: &[f64]) -> f64 {
+    let d: Vec<f64> = trial.iter().zip(x).map(|(t, x)| t - x).collect();
+    let mut gain = 0.0;
+    for (j, &dj) in d.iter().enumerate() {
+        let ad: f64 = normal.a[j].iter().zip(&d).map(|(a, dk)| a * dk).sum();
+        gain -= normal.g[j] * dj + 0.5 * dj * ad;
+    }
+    if normal.wrr > 0.0 {
+        gain / normal.wrr
+    } else {
+        0.0
     }
 }
 
@@ -129,12 +180,16 @@ fn residual_scale(r: &[f32]) -> f64 {
 }
 
 /// The Levenberg–Marquardt step `δ` solving
-/// `(A + λ (diag A + ε)) δ = −g` over the coordinates marked `free` (the
-/// others stay 0). `ε`, a tiny fraction of the largest diagonal entry,
-/// keeps a coordinate the image ignores from making the system singular.
-/// `None` when the system cannot be solved (non-finite input).
-pub fn damped_step(normal: &Normal, lambda: f64, free: &[bool]) -> Option<Vec<f64>> {
-    let index: Vec<usize> = (0..normal.g.len()).filter(|&j| free[j]).collect();
+/// `(A + λ (diag A + ε)) δ = −g` over the coordinates not `fixed` (a fixed
+/// coordinate's step is the value given, and its coupling to the others
+/// moves to the right-hand side). `ε`, a tiny fraction of the largest
+/// diagonal entry, keeps a coordinate the image ignores from making the
+/// system singular. `None` when the system cannot be solved (non-finite
+/// input).
+pub fn damped_step(normal: &Normal, lambda: f64, fixed: &[Option<f64>]) -> Option<Vec<f64>> {
+    let index: Vec<usize> = (0..normal.g.len())
+        .filter(|&j| fixed[j].is_none())
+        .collect();
     let largest = index.iter().map(|&j| normal.a[j][j]).fold(0.0, f64::max);
     let epsilon = (largest * 1e-9).max(1e-12);
     let matrix: Vec<Vec<f64>> = index
@@ -153,9 +208,17 @@ pub fn damped_step(normal: &Normal, lambda: f64, free: &[bool]) -> Option<Vec<f6
                 .collect()
         })
         .collect();
-    let rhs: Vec<f64> = index.iter().map(|&j| -normal.g[j]).collect();
+    let rhs: Vec<f64> = index
+        .iter()
+        .map(|&j| {
+            let coupled: f64 = (0..fixed.len())
+                .filter_map(|k| fixed[k].map(|d| normal.a[j][k] * d))
+                .sum();
+            -normal.g[j] - coupled
+        })
+        .collect();
     let solved = cholesky_solve(&matrix, &rhs)?;
-    let mut step = vec![0.0; normal.g.len()];
+    let mut step: Vec<f64> = fixed.iter().map(|f| f.unwrap_or(0.0)).collect();
     for (&j, v) in index.iter().zip(solved) {
         step[j] = v;
     }
@@ -262,18 +325,31 @@ impl Change {
     }
 }
 
-/// The damped step's end point from `x` in the unit cube: coordinates on a
-/// face whose step would leave the cube are held, and the rest clamped.
-/// None when it does not move or the system cannot be solved.
+/// The damped step's end point from `x` in the unit cube, by an active
+/// set: a coordinate whose step would leave the cube is pinned at the face
+/// it crosses and the others are solved again with it held there, until
+/// no new coordinate is pinned. Clamping each coordinate alone instead
+/// bends the step off the direction the model chose; on a ridge, where
+/// the step is long and the coordinates trade, that lands the trial far
+/// from the model's minimum on the face. None when it does not move or
+/// the system cannot be solved.
 pub fn bounded_trial(normal: &Normal, lambda: f64, x: &[f64]) -> Option<Vec<f64>> {
-    let mut free = vec![true; x.len()];
-    let mut step = damped_step(normal, lambda, &free)?;
-    let blocked = |x: f64, s: f64| (x <= 0.0 && s < 0.0) || (x >= 1.0 && s > 0.0);
-    if x.iter().zip(&step).any(|(&x, &s)| blocked(x, s)) {
-        for (j, f) in free.iter_mut().enumerate() {
-            *f = !blocked(x[j], step[j]);
+    let mut fixed: Vec<Option<f64>> = vec![None; x.len()];
+    let mut step = damped_step(normal, lambda, &fixed)?;
+    // Each pass pins at least one more coordinate, so this ends.
+    loop {
+        let mut pinned = false;
+        for j in 0..x.len() {
+            if fixed[j].is_none() && !(0.0..=1.0).contains(&(x[j] + step[j])) {
+                let face = if x[j] + step[j] < 0.0 { 0.0 } else { 1.0 };
+                fixed[j] = Some(face - x[j]);
+                pinned = true;
+            }
         }
-        step = damped_step(normal, lambda, &free)?;
+        if !pinned || fixed.iter().all(Option::is_some) {
+            break;
+        }
+        step = damped_step(normal, lambda, &fixed)?;
     }
     let trial: Vec<f64> = x
         .iter()
@@ -317,10 +393,25 @@ mod tests {
                 },
             ],
         );
-        let step = damped_step(&normal, 1e-12, &[true, true]).expect("solvable");
+        let step = damped_step(&normal, 1e-12, &[None, None]).expect("solvable");
         assert!((step[0] - 2.0).abs() < 1e-6 && (step[1] + 2.0).abs() < 1e-6);
-        let only_first = damped_step(&normal, 1e-12, &[true, false]).expect("solvable");
+        let only_first = damped_step(&normal, 1e-12, &[None, Some(0.0)]).expect("solvable");
         assert_eq!(only_first[1], 0.0);
+    }
+
+    #[test]
+    fn second_order_columns_are_exact_on_a_quadratic() {
+        // r(u) = 3 + 2u + 5u² at u = 0.5: slope 7; a forward difference of
+        // 0.1 would see 7.5.
+        let f = |u: f64| [(3.0 + 2.0 * u + 5.0 * u * u) as f32];
+        let slope = |d: &[f32], s: f64| (f64::from(d[0]) - f64::from(f(0.5)[0])) / s;
+        let central = second_order(&f(0.5), &f(0.6), 0.1, &f(0.4), -0.1);
+        assert!((slope(&central, 0.1) - 7.0).abs() < 1e-4, "{central:?}");
+        let one_sided = second_order(&f(0.5), &f(0.4), -0.1, &f(0.3), -0.2);
+        assert!(
+            (slope(&one_sided, -0.1) - 7.0).abs() < 1e-4,
+            "{one_sided:?}"
+        );
     }
 
     #[test]

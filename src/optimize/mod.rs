@@ -38,6 +38,7 @@ mod init;
 mod invariants;
 mod jde;
 pub mod lm;
+mod local;
 mod operators;
 mod progress;
 mod rand1bin;

@@ -180,6 +180,7 @@ impl Joint<'_> {
             g: vec![0.0; n],
             jtj: vec![vec![0.0; n]; n],
             scale: 0.0,
+            wrr: 0.0,
         };
         let mut at = 0;
         for (i, r) in centre.iter().enumerate() {
@@ -196,6 +197,7 @@ impl Joint<'_> {
                 })
                 .collect();
             let block = lm::normal_equations(r, &columns);
+            total.wrr += block.wrr;
             for (a, &ja) in cols.iter().enumerate() {
                 total.g[ja] += block.g[a];
                 for (b, &jb) in cols.iter().enumerate() {
