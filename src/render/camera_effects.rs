@@ -236,7 +236,7 @@ mod tests {
         let mut img = Image::from_pixel(2, 2, image::Rgb([188, 0, 255]));
         apply(&cam, &mut img);
         assert_eq!(img.get_pixel(1, 1).0, [128, 0, 255]);
-        // A black level below 0 is subtracted and clips at 0.
+        // A black level below 0 is subtracted and clips at 0: 128.24 - 2.55.
         cam.response = Some(Response {
             black: -0.01,
             encoding: ResponseEncoding::Linear,
@@ -244,6 +244,6 @@ mod tests {
         });
         let mut img = Image::from_pixel(1, 1, image::Rgb([188, 10, 255]));
         apply(&cam, &mut img);
-        assert_eq!(img.get_pixel(0, 0).0, [125, 0, 252]);
+        assert_eq!(img.get_pixel(0, 0).0, [126, 0, 252]);
     }
 }
