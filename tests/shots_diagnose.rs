@@ -113,7 +113,13 @@ fn every_effect_planted_in_a_set_is_the_first_accepted_on_it() {
         }
         let t = std::time::Instant::now();
         let dir = tempfile::tempdir().unwrap();
-        let d = diagnose_set(effect, 1 + i as u64, 0.0, dir.path());
+        // DIAG_KEEP=DIR keeps each case's files in DIR/EFFECT (to look at).
+        let path = match std::env::var("DIAG_KEEP") {
+            Ok(keep) => Path::new(&keep).join(effect),
+            Err(_) => dir.path().to_path_buf(),
+        };
+        std::fs::create_dir_all(&path).unwrap();
+        let d = diagnose_set(effect, 1 + i as u64, 0.0, &path);
         let before = d["deviation_before"]["average"].as_f64().unwrap();
         let after = d["deviation_after"]["average"].as_f64().unwrap();
         let got = first(&d);

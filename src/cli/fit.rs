@@ -185,6 +185,7 @@ fn run_set(a: &FitArgs, scene: &Scene, shots: &[crate::fit::set::shots::Shot]) -
     config.mode = run_mode(a.resume, a.overwrite);
     config.interrupt = Some(interrupt_flag());
     let set = fit::set::SetConfig {
+        spread: Vec::new(),
         fit: config,
         rounds: a.rounds.unwrap_or(4),
         warm: false,

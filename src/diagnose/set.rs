@@ -294,6 +294,17 @@ impl SetRefits<'_> {
 
     /// `scene` (with `own` values) refitted over the set.
     pub(super) fn run(&mut self, scene: &Scene, own: &[Params]) -> Result<SetModel> {
+        self.run_spread(scene, own, Vec::new())
+    }
+
+    /// [`SetRefits::run`] with the shared parameters `spread` names spread
+    /// over their radius in the first shared block (an effect's own).
+    fn run_spread(
+        &mut self,
+        scene: &Scene,
+        own: &[Params],
+        spread: Vec<(String, f64)>,
+    ) -> Result<SetModel> {
         let shots = shots_of(scene, self.inputs, own)?;
         let c = self.config;
         let config = SetConfig {
@@ -314,6 +325,7 @@ impl SetRefits<'_> {
             rounds: 2,
             warm: true,
             joint: false,
+            spread,
         };
         let out = setfit::run_in(scene, &shots, self.renderer, &config, None, &mut ())?;
         self.renders += out.result.evaluations + shots.len();
@@ -491,9 +503,13 @@ fn rounds(
                     .map(move |x| (i, x))
             })
             .collect();
-        let done = super::lanes::side_by_side(fits, &forms, |f, (_, ext)| {
+        let done = super::lanes::side_by_side(fits, &forms, |f, (i, ext)| {
             let (start, own) = f.best_start(ext, &current.own)?;
-            f.run(&start, &own)
+            // The effect's own parameters spread as its refit for one
+            // photograph spreads them: they hold a neutral guess, not a fit.
+            let radius = searched[*i].trades().radius;
+            let spread = ext.added.iter().map(|a| (a.param.clone(), radius)).collect();
+            f.run_spread(&start, &own, spread)
         });
         let mut best: Vec<Option<SetModel>> = searched.iter().map(|_| None).collect();
         for ((i, _), fitted) in forms.iter().zip(done) {

@@ -137,6 +137,13 @@ impl De {
         })
     }
 
+    /// [`De::around`] with a spread per coordinate ([`init::around_each`]).
+    pub fn around_each(dim: usize, config: DeConfig, center: &[f64], radii: &[f64]) -> De {
+        De::with_population(dim, config, |np, rng| {
+            init::around_each(np, dim, center, radii, rng)
+        })
+    }
+
     /// A [`Strategy::Hybrid`] config becomes SHADE (the hybrid's global
     /// phase): a `De` never runs, nor reports, a non-DE strategy.
     fn with_population(

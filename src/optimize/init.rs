@@ -52,19 +52,38 @@ pub fn around<R: Rng>(
     radius: f64,
     rng: &mut R,
 ) -> Vec<Vec<f64>> {
+    around_each(np, dim, center, &vec![radius; dim], rng)
+}
+
+/// [`around`] with a spread per coordinate (a missing one counts as 0):
+/// a refit that adds parameters spreads them over their own range while
+/// the fitted ones stay close.
+pub fn around_each<R: Rng>(
+    np: usize,
+    dim: usize,
+    center: &[f64],
+    radii: &[f64],
+    rng: &mut R,
+) -> Vec<Vec<f64>> {
     let center: Vec<f64> = (0..dim)
         .map(|j| match center.get(j) {
             Some(c) if c.is_finite() => c.clamp(0.0, 1.0),
             _ => 0.5,
         })
         .collect();
-    let radius = if radius > 0.0 { radius.min(1.0) } else { 0.0 };
+    let radii: Vec<f64> = (0..dim)
+        .map(|j| match radii.get(j) {
+            Some(&r) if r > 0.0 => r.min(1.0),
+            _ => 0.0,
+        })
+        .collect();
     let mut population = Vec::with_capacity(np);
     population.push(center.clone());
     for _ in 1..np {
         let individual = center
             .iter()
-            .map(|&c| {
+            .zip(&radii)
+            .map(|(&c, &radius)| {
                 let low = (c - radius).max(0.0);
                 let high = (c + radius).min(1.0);
                 (low + sampling::unit(rng) * (high - low)).clamp(low, high)

@@ -121,6 +121,8 @@ pub enum Start<'a> {
     Uniform,
     /// Around a known point, per-coordinate spread `radius` ([`De::around`]).
     Around { center: &'a [f64], radius: f64 },
+    /// Around a known point, a spread per coordinate ([`De::around_each`]).
+    AroundEach { center: &'a [f64], radii: &'a [f64] },
 }
 
 impl Searcher {
@@ -131,6 +133,9 @@ impl Searcher {
         let global = match start {
             Start::Uniform => De::new(dim, config.clone()),
             Start::Around { center, radius } => De::around(dim, config.clone(), center, radius),
+            Start::AroundEach { center, radii } => {
+                De::around_each(dim, config.clone(), center, radii)
+            }
         };
         match config.strategy {
             Strategy::Hybrid => Searcher::Hybrid(Hybrid::new(global, config)),

@@ -59,6 +59,12 @@ pub struct SetConfig {
     /// generated set missing a second light it fitted the wrong model
     /// better, and the diagnosis then chose area_light (docs/sets.md).
     pub joint: bool,
+    /// Shared parameters (by name) a warm refit has just added: the first
+    /// shared block spreads each over this unit-cube radius instead of
+    /// starting it around its value, which is a neutral guess, not a fit
+    /// (a second light at zero intensity would otherwise never leave
+    /// where it was put).
+    pub spread: Vec<(String, f64)>,
 }
 
 /// Relative improvement of a round below which the blocks stop.
@@ -68,6 +74,28 @@ const LATER_RADIUS: f64 = 0.1;
 /// Generations without improvement that end a block when `--stagnation`
 /// is not given: a block is one step of an alternation, not the last word.
 const BLOCK_STAGNATION: usize = 30;
+
+/// Each shared coordinate's start spread in a shared block: a fresh fit's
+/// first block searches the whole box (the current values one member of
+/// its population: the scene's values are a guess), a warm refit's first
+/// block spreads its new parameters as `config.spread` says, and every
+/// other block starts around the current values.
+fn start_radii(shared: &ParamSpace, first: bool, config: &SetConfig) -> Vec<f64> {
+    let mut radii = Vec::with_capacity(shared.dim());
+    for spec in &shared.specs {
+        let radius = match (first, config.warm) {
+            (true, false) => 1.0,
+            (true, true) => config
+                .spread
+                .iter()
+                .find(|(name, _)| *name == spec.name)
+                .map_or(LATER_RADIUS, |s| s.1),
+            (false, _) => LATER_RADIUS,
+        };
+        radii.extend(std::iter::repeat_n(radius, spec.dim()));
+    }
+    radii
+}
 
 /// A block's search options: the run's, with a population of ten per
 /// coordinate (DE's usual rule; at least 16, at most the run's) and a
@@ -331,16 +359,10 @@ fn shared_block(
     let cfg = block_config(&config.fit, shared.dim(), seed);
     // A fresh fit's first shared block searches the whole box (the current
     // values one member of its population): the scene's values are a guess.
-    let start = if state.shared_blocks == 0 && !config.warm {
-        Start::Around {
-            center: &state.shared,
-            radius: 1.0,
-        }
-    } else {
-        Start::Around {
-            center: &state.shared,
-            radius: LATER_RADIUS,
-        }
+    let radii = start_radii(&shared, state.shared_blocks == 0, config);
+    let start = Start::AroundEach {
+        center: &state.shared,
+        radii: &radii,
     };
     let mut search = Searcher::new(shared.dim(), &cfg.de, start);
     let mut executor = Executor {
