@@ -32,7 +32,9 @@
 //! reports, and acceptance compares that same fitness. Bounds by an
 //! active set (`lm::bounded_trial`). Difference steps adapt per coordinate
 //! from the change they produce (`lm::adapt_step`), since the images are
-//! 8-bit, and carry over from one local run to the next.
+//! 8-bit, and carry over from one local run to the next. A periodic
+//! coordinate (a hue, [`Hybrid::set_periods`]) steps round its circle
+//! instead of stopping at a face (`lm::wrap`).
 //!
 //! **Back to the global phase.** A local run ends when its last few steps
 //! lowered the log fitness per render less than the global phase did over
