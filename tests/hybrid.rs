@@ -276,7 +276,11 @@ fn bits(v: &[f64]) -> Vec<u64> {
 #[test]
 fn same_seed_gives_the_same_run_and_a_checkpoint_mid_local_phase_continues_identically() {
     let problem = Blobs::new(&blob_truth());
+    // One periodic coordinate (as a hue's), which the checkpoint must keep.
+    let mut periods = vec![0.0; 12];
+    periods[3] = 2.0 / 3.0;
     let mut first = Searcher::new(12, &config(Strategy::Hybrid, 5), Start::Uniform);
+    first.set_periods(periods.clone());
     // Run into the local phase, then a few steps further.
     let mut local_steps = 0;
     while local_steps < 3 {
@@ -288,8 +292,16 @@ fn same_seed_gives_the_same_run_and_a_checkpoint_mid_local_phase_continues_ident
         assert!(!first.converged(), "converged before the checkpoint");
     }
     let text = serde_json::to_string(&first).expect("serialise");
+    let state: serde_json::Value = serde_json::from_str(&text).expect("json");
+    let bits_of = |v: &serde_json::Value| v[3].as_u64();
+    assert_eq!(
+        bits_of(&state["hybrid"]["periods"]),
+        Some((2.0f64 / 3.0).to_bits()),
+        "the checkpoint keeps the periods"
+    );
     let mut resumed: Searcher = serde_json::from_str(&text).expect("deserialise");
     let mut second = Searcher::new(12, &config(Strategy::Hybrid, 5), Start::Uniform);
+    second.set_periods(periods);
     for search in [&mut first, &mut resumed, &mut second] {
         run(search, &problem, 0.0, 60_000);
     }

@@ -424,10 +424,33 @@ fn new_search(config: &FitConfig, sub: &ParamSpace, base: &Scene, phase_index: u
         None => Start::Uniform,
     };
     let mut search = Searcher::new(sub.dim(), &de, start);
+    search.set_periods(periods(sub));
     if config.settle {
         search.settle();
     }
     search
+}
+
+/// Each unit coordinate's period in unit coordinates, 0 if none: a hue
+/// whose bounds span the whole circle is searched over an interval that
+/// overlaps itself (`ParamSpace::from_scene`), so moving it by one turn
+/// gives the same colour.
+pub(crate) fn periods(space: &ParamSpace) -> Vec<f64> {
+    space
+        .specs
+        .iter()
+        .flat_map(|s| {
+            (0..s.dim()).map(move |c| {
+                let span = s.max[c] - s.min[c];
+                let circle = s.hsv && c == 0 && s.min[0] <= 0.0 && s.max[0] >= 1.0 && span > 1.0;
+                if circle {
+                    1.0 / span
+                } else {
+                    0.0
+                }
+            })
+        })
+        .collect()
 }
 
 /// Generations for each phase; every phase gets at least one.

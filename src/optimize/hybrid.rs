@@ -32,7 +32,9 @@
 //! reports, and acceptance compares that same fitness. Bounds by an
 //! active set (`lm::bounded_trial`). Difference steps adapt per coordinate
 //! from the change they produce (`lm::adapt_step`), since the images are
-//! 8-bit, and carry over from one local run to the next.
+//! 8-bit, and carry over from one local run to the next. A periodic
+//! coordinate (a hue, [`Hybrid::set_periods`]) steps round its circle
+//! instead of stopping at a face (`lm::wrap`).
 //!
 //! **Back to the global phase.** A local run ends when its last few steps
 //! lowered the log fitness per render less than the global phase did over
@@ -145,6 +147,10 @@ pub struct Hybrid {
     /// Local runs from other basins since one bettered the global best.
     #[serde(default)]
     fresh_tries: usize,
+    /// Each coordinate's period in unit coordinates, 0 if none (a hue;
+    /// see [`Hybrid::set_periods`]); empty: none is periodic.
+    #[serde(with = "exact::vector", default)]
+    periods: Vec<f64>,
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -241,6 +247,18 @@ impl Hybrid {
             at_best: None,
             settle: false,
             fresh_tries: 0,
+            periods: Vec::new(),
+        }
+    }
+
+    /// Declares periodic coordinates: `periods[j]` is coordinate j's
+    /// period in unit coordinates (0: not periodic), as for a hue searched
+    /// over an interval that overlaps itself. The local phase then steps
+    /// round the circle instead of stopping at a face (`lm::wrap`). A
+    /// vector of the wrong length is ignored.
+    pub fn set_periods(&mut self, periods: Vec<f64>) {
+        if periods.len() == self.dim {
+            self.periods = periods;
         }
     }
 
@@ -336,13 +354,19 @@ impl Hybrid {
         } else {
             0.0
         };
-        self.starts.push(start.clone());
         // Only a stint after a local run counts: the first one began at
         // the first generation, not where the phases last agreed.
         let global_done = from_best
             && !self.ends.is_empty()
             && fitness >= self.stint_fitness * (1.0 - SETTLED_GAIN);
-        self.phase = Phase::Local(Local::start(start, self.steps.clone(), rate, global_done));
+        self.phase = Phase::Local(Local::start(
+            &start,
+            self.steps.clone(),
+            rate,
+            global_done,
+            &self.periods,
+        ));
+        self.starts.push(start);
     }
 
     /// The best population member farther than [`START_SEPARATION`]
@@ -437,6 +461,7 @@ impl Hybrid {
         let mut ok = self.global.dim() == dim
             && self.best.len() == dim
             && self.steps.len() == dim
+            && (self.periods.is_empty() || self.periods.len() == dim)
             && self.starts.iter().chain(&self.ends).all(|s| s.len() == dim)
             && self.at_best.as_ref().is_none_or(normal_ok);
         if let Phase::Local(local) = &self.phase {

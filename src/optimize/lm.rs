@@ -151,10 +151,45 @@ pub fn normal_equations(r: &[f32], columns: &[Column]) -> Normal {
     }
 }
 
+/// The period of coordinate `j` in unit coordinates (0: not periodic;
+/// an empty `periods` has none).
+fn period(periods: &[f64], j: usize) -> f64 {
+    periods.get(j).copied().filter(|p| *p > 0.0).unwrap_or(0.0)
+}
+
+/// `x` with each periodic coordinate moved by whole periods to the
+/// representative nearest the cube's centre. A periodic coordinate (a
+/// hue, searched over an interval that overlaps itself) has several
+/// points in the cube with the same image; the central one is farthest
+/// from the faces, so a local step is not stopped at a face of the
+/// overlap while the circle goes on.
+pub fn wrap(x: &[f64], periods: &[f64]) -> Vec<f64> {
+    x.iter()
+        .enumerate()
+        .map(|(j, &v)| match period(periods, j) {
+            p if p > 0.0 => (v - p * ((v - 0.5) / p).round()).clamp(0.0, 1.0),
+            _ => v,
+        })
+        .collect()
+}
+
+/// The step from `x` to `y`, each periodic coordinate's the shortest way
+/// round its circle.
+pub fn offset(x: &[f64], y: &[f64], periods: &[f64]) -> Vec<f64> {
+    x.iter()
+        .zip(y)
+        .enumerate()
+        .map(|(j, (a, b))| match (b - a, period(periods, j)) {
+            (d, p) if p > 0.0 => d - p * (d / p).round(),
+            (d, _) => d,
+        })
+        .collect()
+}
+
 /// The relative decrease of the reweighted sum the model predicts for the
 /// step from `x` to `trial`: `(−gᵀδ − ½ δᵀAδ) / rᵀWr` (0 when unknown).
-pub fn predicted_gain(normal: &Normal, x: &[f64], trial: &[f64]) -> f64 {
-    let d: Vec<f64> = trial.iter().zip(x).map(|(t, x)| t - x).collect();
+pub fn predicted_gain(normal: &Normal, x: &[f64], trial: &[f64], periods: &[f64]) -> f64 {
+    let d = offset(x, trial, periods);
     let mut gain = 0.0;
     for (j, &dj) in d.iter().enumerate() {
         let ad: f64 = normal.a[j].iter().zip(&d).map(|(a, dk)| a * dk).sum();
@@ -331,16 +366,18 @@ impl Change {
 /// no new coordinate is pinned. Clamping each coordinate alone instead
 /// bends the step off the direction the model chose; on a ridge, where
 /// the step is long and the coordinates trade, that lands the trial far
-/// from the model's minimum on the face. None when it does not move or
-/// the system cannot be solved.
-pub fn bounded_trial(normal: &Normal, lambda: f64, x: &[f64]) -> Option<Vec<f64>> {
+/// from the model's minimum on the face. A periodic coordinate is never
+/// pinned: its step goes round the circle ([`wrap`]). None when it does
+/// not move or the system cannot be solved.
+pub fn bounded_trial(normal: &Normal, lambda: f64, x: &[f64], periods: &[f64]) -> Option<Vec<f64>> {
     let mut fixed: Vec<Option<f64>> = vec![None; x.len()];
     let mut step = damped_step(normal, lambda, &fixed)?;
     // Each pass pins at least one more coordinate, so this ends.
     loop {
         let mut pinned = false;
         for j in 0..x.len() {
-            if fixed[j].is_none() && !(0.0..=1.0).contains(&(x[j] + step[j])) {
+            let inside = (0.0..=1.0).contains(&(x[j] + step[j])) || period(periods, j) > 0.0;
+            if fixed[j].is_none() && !inside {
                 let face = if x[j] + step[j] < 0.0 { 0.0 } else { 1.0 };
                 fixed[j] = Some(face - x[j]);
                 pinned = true;
@@ -351,10 +388,10 @@ pub fn bounded_trial(normal: &Normal, lambda: f64, x: &[f64]) -> Option<Vec<f64>
         }
         step = damped_step(normal, lambda, &fixed)?;
     }
-    let trial: Vec<f64> = x
-        .iter()
-        .zip(&step)
-        .map(|(&x, &s)| (x + s).clamp(0.0, 1.0))
+    let moved: Vec<f64> = x.iter().zip(&step).map(|(&x, &s)| x + s).collect();
+    let trial: Vec<f64> = wrap(&moved, periods)
+        .into_iter()
+        .map(|v| v.clamp(0.0, 1.0))
         .collect();
     (trial != x).then_some(trial)
 }
@@ -411,6 +448,33 @@ mod tests {
         assert!(
             (slope(&one_sided, -0.1) - 7.0).abs() < 1e-4,
             "{one_sided:?}"
+        );
+    }
+
+    #[test]
+    fn a_periodic_coordinate_steps_round_its_circle() {
+        // r(x) = x0 + 0.3 at x0 = 0.1: the step to -0.3 leaves the cube;
+        // with period 2/3 it lands at -0.3 + 2/3 instead of the face.
+        let r = [0.3f32];
+        let moved = [1.3f32];
+        let column = Column {
+            residuals: Some(&moved),
+            step: 1.0,
+        };
+        let normal = normal_equations(&r, &[column]);
+        let x = [0.1];
+        let pinned = bounded_trial(&normal, 1e-12, &x, &[]).expect("moves");
+        assert_eq!(pinned, vec![0.0]);
+        let period = 2.0 / 3.0;
+        let round = bounded_trial(&normal, 1e-12, &x, &[period]).expect("moves");
+        assert!((round[0] - (period - 0.2)).abs() < 1e-6, "{round:?}");
+        let d = offset(&x, &round, &[period]);
+        assert!((d[0] + 0.3).abs() < 1e-6, "{d:?}");
+        let straight = predicted_gain(&normal, &x, &[-0.2], &[]);
+        assert!((predicted_gain(&normal, &x, &round, &[period]) - straight).abs() < 1e-6);
+        assert_eq!(
+            wrap(&[0.05, 0.05], &[period, 0.0]),
+            vec![0.05 + period, 0.05]
         );
     }
 

@@ -100,10 +100,22 @@ pub struct Local {
     /// gained less than the hybrid's settled gain (the global phase is done
     /// there).
     pub global_done: bool,
+    /// Each coordinate's period in unit coordinates, 0 if none (see
+    /// `lm::wrap`; empty: none is periodic).
+    #[serde(with = "exact::vector", default)]
+    periods: Vec<f64>,
 }
 
 impl Local {
-    pub fn start(x: Vec<f64>, steps: Vec<f64>, rate_floor: f64, global_done: bool) -> Local {
+    pub fn start(
+        x: &[f64],
+        steps: Vec<f64>,
+        rate_floor: f64,
+        global_done: bool,
+        periods: &[f64],
+    ) -> Local {
+        // The same image, farther from the faces (see `lm::wrap`).
+        let x = lm::wrap(x, periods);
         let batch = neighbourhood(&x, &steps);
         Local {
             x,
@@ -121,6 +133,7 @@ impl Local {
             rate_floor,
             outpaced: false,
             global_done,
+            periods: periods.to_vec(),
         }
     }
 
@@ -137,6 +150,7 @@ impl Local {
         };
         self.x.len() == dim
             && self.steps.len() == dim
+            && (self.periods.is_empty() || self.periods.len() == dim)
             && self.batch.len() == expected
             && self.batch.iter().all(|p| p.len() == dim)
     }
@@ -231,13 +245,15 @@ impl Local {
         }
         self.stalled += 1;
         self.record();
-        let rejected = distance(&self.batch[0], &self.x);
+        let rejected = distance(&self.batch[0], &self.x, &self.periods);
         if let Some(normal) = &self.normal {
             // Raise the damping until the trial is clearly shorter.
             while self.lambda <= LAMBDA_MAX {
                 self.lambda *= LAMBDA_UP;
-                match lm::bounded_trial(normal, self.lambda, &self.x) {
-                    Some(t) if distance(&t, &self.x) > SHORTEN * rejected => continue,
+                match lm::bounded_trial(normal, self.lambda, &self.x, &self.periods) {
+                    Some(t) if distance(&t, &self.x, &self.periods) > SHORTEN * rejected => {
+                        continue
+                    }
                     _ => break,
                 }
             }
@@ -265,10 +281,10 @@ impl Local {
         let Some(normal) = &self.normal else {
             return false;
         };
-        let Some(trial) = lm::bounded_trial(normal, self.lambda, &self.x) else {
+        let Some(trial) = lm::bounded_trial(normal, self.lambda, &self.x, &self.periods) else {
             return false;
         };
-        self.predicted = lm::predicted_gain(normal, &self.x, &trial);
+        self.predicted = lm::predicted_gain(normal, &self.x, &trial, &self.periods);
         self.batch = vec![trial];
         self.probe = Probe::Trial;
         true
@@ -288,11 +304,12 @@ impl Local {
     }
 }
 
-/// Euclidean distance in the unit cube.
-fn distance(a: &[f64], b: &[f64]) -> f64 {
-    a.iter()
-        .zip(b)
-        .map(|(a, b)| (a - b).powi(2))
+/// Euclidean distance in the unit cube, a periodic coordinate's the
+/// shortest way round.
+fn distance(a: &[f64], b: &[f64], periods: &[f64]) -> f64 {
+    lm::offset(a, b, periods)
+        .iter()
+        .map(|d| d * d)
         .sum::<f64>()
         .sqrt()
 }

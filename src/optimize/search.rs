@@ -161,6 +161,14 @@ impl Searcher {
         }
     }
 
+    /// Declares periodic coordinates for a hybrid search
+    /// ([`Hybrid::set_periods`]); a DE search is left as it is.
+    pub fn set_periods(&mut self, periods: Vec<f64>) {
+        if let Searcher::Hybrid(h) = self {
+            h.set_periods(periods);
+        }
+    }
+
     /// The strategy this search runs.
     pub fn strategy(&self) -> Strategy {
         match self {

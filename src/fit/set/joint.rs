@@ -288,7 +288,7 @@ pub fn run(
         && lambda <= LAMBDA_MAX
         && fit > 0.0
     {
-        let Some(trial) = lm::bounded_trial(&normal, lambda, &x) else {
+        let Some(trial) = lm::bounded_trial(&normal, lambda, &x, &[]) else {
             break;
         };
         let (r, f) = joint.centre(&trial);

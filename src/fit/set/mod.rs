@@ -365,6 +365,7 @@ fn shared_block(
         radii: &radii,
     };
     let mut search = Searcher::new(shared.dim(), &cfg.de, start);
+    search.set_periods(crate::fit::periods(&shared));
     let mut executor = Executor {
         rule: StopRule {
             max_generations: cfg.generations,
