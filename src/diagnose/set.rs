@@ -491,34 +491,7 @@ fn rounds(
         // The searched effects' refits side by side (`lanes.rs`).
         let searched: Vec<&dyn Effect> =
             open.iter().copied().filter(|e| !e.closed_form()).collect();
-        let current = &*model;
-        // Every form of every searched effect, refitted side by side; each
-        // effect's best form counts.
-        let forms: Vec<(usize, effects::Extension)> = searched
-            .iter()
-            .enumerate()
-            .flat_map(|(i, &e)| {
-                effects::forms(e, &current.scene)
-                    .into_iter()
-                    .map(move |x| (i, x))
-            })
-            .collect();
-        let done = super::lanes::side_by_side(fits, &forms, |f, (i, ext)| {
-            let (start, own) = f.best_start(ext, &current.own)?;
-            // The effect's own parameters spread as its refit for one
-            // photograph spreads them: they hold a neutral guess, not a fit.
-            let radius = searched[*i].trades().radius;
-            let spread = ext.added.iter().map(|a| (a.param.clone(), radius)).collect();
-            f.run_spread(&start, &own, spread)
-        });
-        let mut best: Vec<Option<SetModel>> = searched.iter().map(|_| None).collect();
-        for ((i, _), fitted) in forms.iter().zip(done) {
-            let fitted = fitted?;
-            best[*i] = Some(match best[*i].take() {
-                Some(b) => b.better(fitted),
-                None => fitted,
-            });
-        }
+        let best = refit_effects(fits, model, &searched)?;
         let mut refitted = best.into_iter();
         let mut tried: Vec<(Candidate, SetModel)> = Vec::new();
         for effect in open {
@@ -566,6 +539,46 @@ fn rounds(
         }
     }
     Ok((candidates, accepted))
+}
+
+/// Every form of every effect in `searched` added to `model` and refitted
+/// over the set, side by side (`lanes.rs`); each effect's best form (None:
+/// it does not apply).
+fn refit_effects(
+    fits: &mut SetRefits,
+    model: &SetModel,
+    searched: &[&dyn Effect],
+) -> Result<Vec<Option<SetModel>>> {
+    let forms: Vec<(usize, effects::Extension)> = searched
+        .iter()
+        .enumerate()
+        .flat_map(|(i, &e)| {
+            effects::forms(e, &model.scene)
+                .into_iter()
+                .map(move |x| (i, x))
+        })
+        .collect();
+    let done = super::lanes::side_by_side(fits, &forms, |f, (i, ext)| {
+        let (start, own) = f.best_start(ext, &model.own)?;
+        // The effect's own parameters spread as its refit for one
+        // photograph spreads them: they hold a neutral guess, not a fit.
+        let radius = searched[*i].trades().radius;
+        let spread = ext
+            .added
+            .iter()
+            .map(|a| (a.param.clone(), radius))
+            .collect();
+        f.run_spread(&start, &own, spread)
+    });
+    let mut best: Vec<Option<SetModel>> = searched.iter().map(|_| None).collect();
+    for ((i, _), fitted) in forms.iter().zip(done) {
+        let fitted = fitted?;
+        best[*i] = Some(match best[*i].take() {
+            Some(b) => b.better(fitted),
+            None => fitted,
+        });
+    }
+    Ok(best)
 }
 
 /// The deviation over every photograph.
