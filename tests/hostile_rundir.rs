@@ -419,14 +419,25 @@ fn outputs_follow_the_umask() {
     assert!(out.status.success(), "{}", stderr(&out));
     let out = scenefit_sh(d.path(), "umask 022", "render scene.json -o r.png");
     assert!(out.status.success(), "{}", stderr(&out));
+    // Every file the run left (a run that converges early snapshots only
+    // the generations it reached), and the rendered image.
+    let mut files: Vec<String> = std::fs::read_dir(d.path().join("run"))
+        .unwrap()
+        .flatten()
+        .map(|e| format!("run/{}", e.file_name().to_string_lossy()))
+        .collect();
+    files.sort();
     for f in [
         "run/result.json",
         "run/best.png",
         "run/fitted_scene.json",
         "run/checkpoint.json",
-        "run/best_g0010.bmp",
-        "r.png",
+        "run/best_g0000.bmp",
     ] {
+        assert!(files.iter().any(|x| x == f), "{f} missing: {files:?}");
+    }
+    files.push("r.png".into());
+    for f in &files {
         let mode = std::fs::metadata(d.path().join(f))
             .unwrap()
             .permissions()

@@ -32,6 +32,10 @@ pub enum StopReason {
     Generations,
     Target,
     Stagnation,
+    /// The search has nothing left to try ([`Search::converged`]): said
+    /// apart from the budget, so a run that ended early does not read as
+    /// one cut short.
+    Converged,
 }
 
 impl fmt::Display for StopReason {
@@ -40,6 +44,7 @@ impl fmt::Display for StopReason {
             StopReason::Generations => "generation budget used up",
             StopReason::Target => "target fitness reached",
             StopReason::Stagnation => "best fitness stagnated",
+            StopReason::Converged => "converged: nothing left to move",
         })
     }
 }
@@ -66,8 +71,11 @@ impl StopRule {
                 return Some(StopReason::Stagnation);
             }
         }
-        if de.generation() >= self.max_generations || (started && de.converged()) {
+        if de.generation() >= self.max_generations {
             return Some(StopReason::Generations);
+        }
+        if started && de.converged() {
+            return Some(StopReason::Converged);
         }
         None
     }
