@@ -2,14 +2,15 @@
 //! one scene, the light moved from one to the next, each with the same
 //! undeclared effect (noise-free photographs, as in tests/diagnose.rs).
 //! For every effect the diagnosis knows, the first effect accepted on the
-//! set is the planted one, the deviation falls to at most half of what it
-//! was for every effect and to at most 30 % for all but two (measured: 7
-//! of 9; second_light and area_light end at about 0.4, docs/results.md);
-//! a set with noise only accepts nothing.
+//! set is the planted one (each photograph's own light colour among them, an
+//! effect only a set shows), the deviation falls to at most half of what it
+//! was for every effect and to at most 30 % for all but one (measured: 8
+//! of 9; area_light ends at 0.42, docs/results.md); a set with noise only
+//! accepts nothing.
 
 mod effects_data;
 
-use effects_data::{case, effects};
+use effects_data::{case, set_effects};
 use scenefit::render::{from_spec, render_one};
 use serde_json::json;
 use std::path::Path;
@@ -28,6 +29,16 @@ fn diagnose_set(effect: &str, seed: u64, noise: f64, dir: &Path) -> serde_json::
         let mut s = c.truth.clone();
         let p = s.lights[0].position.unwrap();
         s.lights[0].position = Some([p[0] + 1.2 * a.cos(), p[1], p[2] + 1.2 * a.sin()]);
+        if effect == "light_color" {
+            // Each photograph's light a colour of its own, up to ±15 % in
+            // red and blue (a light stage's LEDs).
+            let c = s.lights[0].color;
+            s.lights[0].color = [
+                c[0] * (1.0 + 0.15 * (a + 0.5).sin()),
+                c[1],
+                c[2] * (1.0 + 0.15 * (2.0 * a).cos()),
+            ];
+        }
         let mut img = render_one(phong.as_ref(), &s, 0).unwrap();
         effects_data::add_noise(&mut img, noise, seed * 100 + i as u64);
         let name = format!("s{i}");
@@ -106,7 +117,7 @@ fn every_effect_planted_in_a_set_is_the_first_accepted_on_it() {
     let mut lines = Vec::new();
     let mut wrong = Vec::new();
     let mut above_30 = Vec::new();
-    for (i, effect) in effects().iter().enumerate() {
+    for (i, effect) in set_effects().iter().enumerate() {
         // DIAG_ONLY=effect,effect runs a subset (when tuning).
         if std::env::var("DIAG_ONLY").is_ok_and(|o| !o.split(',').any(|x| x == *effect)) {
             continue;
@@ -138,7 +149,7 @@ fn every_effect_planted_in_a_set_is_the_first_accepted_on_it() {
     println!("{}", lines.join("\n"));
     assert!(wrong.is_empty(), "wrong: {wrong:?}\n{}", lines.join("\n"));
     assert!(
-        above_30.len() <= 2,
+        above_30.len() <= 1,
         "after > 30 % of before: {above_30:?}\n{}",
         lines.join("\n")
     );

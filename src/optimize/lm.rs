@@ -115,6 +115,11 @@ pub fn normal_equations(r: &[f32], columns: &[Column]) -> Normal {
         .map(|c| c.residuals.is_some_and(|d| d.len() == r.len()) && c.step != 0.0)
         .collect();
     let mut row = vec![0.0; p];
+    // The residuals of the values some coordinate moves: only those enter
+    // the covariance, so only their spread is the noise that matters (a
+    // black background, exact in target and render, would halve a scale
+    // taken over every value).
+    let mut moved: Vec<f32> = Vec::new();
     for (i, &ri) in r.iter().enumerate() {
         let ri = f64::from(ri);
         for (j, column) in columns.iter().enumerate() {
@@ -122,6 +127,9 @@ pub fn normal_equations(r: &[f32], columns: &[Column]) -> Normal {
                 (true, Some(d)) => (f64::from(d[i]) - ri) / column.step,
                 _ => 0.0,
             };
+        }
+        if row.iter().any(|&x| x != 0.0) {
+            moved.push(ri as f32);
         }
         let w = 1.0 / ri.abs().max(WEIGHT_FLOOR);
         wrr += w * ri * ri;
@@ -146,7 +154,7 @@ pub fn normal_equations(r: &[f32], columns: &[Column]) -> Normal {
         a,
         g,
         jtj,
-        scale: residual_scale(r),
+        scale: residual_scale(if moved.is_empty() { r } else { &moved }),
         wrr,
     }
 }
@@ -399,6 +407,26 @@ pub fn bounded_trial(normal: &Normal, lambda: f64, x: &[f64], periods: &[f64]) -
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_scale_counts_only_values_a_coordinate_moves() {
+        // Four values the coordinate moves, with residuals of 4 levels,
+        // and four it does not (a black background, exact in both).
+        let r = [4.0, -4.0, 4.0, -4.0, 0.0, 0.0, 0.0, 0.0];
+        let d = [5.0, -3.0, 5.0, -3.0, 0.0, 0.0, 0.0, 0.0];
+        let n = normal_equations(
+            &r,
+            &[Column {
+                residuals: Some(&d),
+                step: 0.1,
+            }],
+        );
+        assert!(
+            (n.scale - LAD_FACTOR * MAD_TO_SIGMA * 4.0).abs() < 1e-9,
+            "{}",
+            n.scale
+        );
+    }
 
     #[test]
     fn cholesky_solves_a_known_system() {

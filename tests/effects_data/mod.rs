@@ -17,6 +17,18 @@ use std::path::Path;
 /// `albedo_map`: planting it needs a map file, and one photograph cannot
 /// tell it (tests/albedo_map.rs tries it on sets).
 pub fn effects() -> Vec<&'static str> {
+    set_effects()
+        .into_iter()
+        .filter(|&e| !SET_ONLY.contains(&e))
+        .collect()
+}
+
+/// Effects only a set of photographs can show: each photograph's own
+/// light colour (for one photograph it is the material's colour).
+pub const SET_ONLY: &[&str] = &["light_color"];
+
+/// The effects a generated set plants: [`effects`] and [`SET_ONLY`].
+pub fn set_effects() -> Vec<&'static str> {
     scenefit::diagnose::effects::names()
         .into_iter()
         .filter(|&e| e != "albedo_map")

@@ -13,6 +13,7 @@ mod camera_response;
 pub mod edit;
 mod fresnel;
 mod indirect_light;
+mod light_color;
 mod light_falloff;
 mod second_light;
 mod specular_lobe;
@@ -88,6 +89,7 @@ pub static ALL: &[&dyn Effect] = &[
     &indirect_light::IndirectLight,
     &fresnel::Fresnel,
     &specular_lobe::SpecularLobe,
+    &light_color::LightColor,
     &albedo_map::AlbedoMap,
 ];
 
@@ -154,8 +156,10 @@ mod tests {
     use crate::scene::Field;
 
     const MATERIAL: &str = r#""color": [0.8, 0.7, 0.1], "specular": 0.3"#;
+    // The light's position per photograph, so that the effects of a set
+    // (light_color) apply too.
     const FREE: &str = r#"
-        {"param": "lights.key.position", "min": [-3, 0.5, -3], "max": [3, 5, 5]},
+        {"param": "lights.key.position", "min": [-3, 0.5, -3], "max": [3, 5, 5], "per_shot": true},
         {"param": "lights.key.intensity", "min": 1, "max": 50},
         {"param": "objects.ball.material.color", "min": 0, "max": 1}"#;
 
