@@ -14,36 +14,42 @@
 #
 # Usage: scripts/bench-noisy.sh [SEEDS=3] [OUTDIR=/tmp/bench-noisy]
 # Env: SCENEFIT (binary; default target/release/scenefit), RENDERERS
-#      (default "mitsuba blender"), BUDGETS (default "500 1000 2000 4000"),
-#      JOBS (default 2).
+#      (default "mitsuba blender"), BUDGETS (default "1000 2000 4000 8000";
+#      progress.txt has a line every 10 generations, 400 renders of
+#      SHADE), SAMPLES (default 16), RADIUS (default 0), JOBS (default 2),
+#      LIMIT (seconds a run may take, default 3600: a run stopped by it
+#      still counts up to the budgets its progress.txt reached).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seeds=${1:-3}
 out=${2:-/tmp/bench-noisy}
 bin=${SCENEFIT:-target/release/scenefit}
 renderers=${RENDERERS:-"mitsuba blender"}
-budgets=${BUDGETS:-"500 1000 2000 4000"}
+budgets=${BUDGETS:-"1000 2000 4000 8000"}
 jobs=${JOBS:-2}
 if [ -z "${DRJIT_LIBLLVM_PATH:-}" ] && [ -e /usr/lib/x86_64-linux-gnu/libLLVM-19.so ]; then
   export DRJIT_LIBLLVM_PATH=/usr/lib/x86_64-linux-gnu/libLLVM-19.so
 fi
 mkdir -p "$out"
 
-# sphere_floor at 64x48, 16 samples, direct light only; the truth of
-# scripts/bench-hybrid.sh.
-small=(--set 'image={"width":64,"height":48}' --set 'render={"samples":16,"indirect":false}')
+# sphere_floor at its 128x96, SAMPLES samples (default 16) per pixel,
+# direct light only, the key light a sphere of RADIUS (default 0: a point
+# light, whose direct light leaves only the pixels' antialiasing to
+# sample; a radius makes soft shadows that the samples estimate); the
+# truth of scripts/bench-hybrid.sh.
+samples=${SAMPLES:-16}
+radius=${RADIUS:-0}
 truth=(
   --set 'lights.key.position=[1.4,3.6,2.5]'
   --set lights.key.intensity=14
   --set 'objects.ball.material.color=[0.3,0.6,0.8]'
 )
 scene="$out/scene.json"
-"$bin" render scenes/sphere_floor.json -o "$out/probe.png" "${small[@]}" >/dev/null
-python3 - "$scene" <<'PY'
+python3 - "$scene" "$samples" "$radius" <<'PY'
 import json, sys
 s = json.load(open("scenes/sphere_floor.json"))
-s["image"] = {"width": 64, "height": 48}
-s["render"] = {"samples": 16, "indirect": False}
+s["render"] = {"samples": int(sys.argv[2]), "indirect": False}
+s["lights"][0]["radius"] = float(sys.argv[3])
 json.dump(s, open(sys.argv[1], "w"), indent=1)
 PY
 
@@ -73,11 +79,16 @@ PY
   for strategy in shade hybrid; do
     for seed in $(seq 1 "$seeds"); do
       dir="$out/$renderer-$strategy-$seed"
-      # Enough generations for the largest budget; the budget is cut from
-      # progress.txt afterwards.
-      timeout 3600 "$bin" fit "$scene" --renderer "$renderer" --target "$out/$renderer-target.png" \
+      # Enough generations for the largest budget (a local batch of the
+      # hybrid is 1 or 2P+1 renders, not a population); the budget is cut
+      # from progress.txt afterwards.
+      case $strategy in
+        shade) generations=$((largest / 40 + 10)) ;;
+        *) generations=$((largest / 8)) ;;
+      esac
+      timeout "${LIMIT:-3600}" "$bin" fit "$scene" --renderer "$renderer" --target "$out/$renderer-target.png" \
         -o "$dir" --overwrite --strategy "$strategy" --seed "$seed" --jobs "$jobs" \
-        --population 40 --generations $((largest / 4)) >/dev/null 2>&1 || true
+        --population 40 --generations "$generations" >/dev/null 2>&1 || true
       python3 - "$dir/progress.txt" "$renderer" "$strategy" "$seed" "$budgets" >>"$results" <<'PY'
 import sys
 path, renderer, strategy, seed, budgets = sys.argv[1:6]
@@ -91,7 +102,7 @@ out = []
 for b in map(int, budgets.split()):
     seen = [d for n, d in rows if n <= b]
     out.append(f"{min(seen):.4f}" if seen else "-")
-print("\t".join([renderer, strategy, seed] + out))
+print("\t".join([renderer, strategy, seed] + out + [f"({rows[-1][0]} renders)"]))
 PY
       tail -n 1 "$results"
     done
@@ -105,7 +116,7 @@ from collections import defaultdict
 runs = defaultdict(list)
 for line in open(sys.argv[1]):
     f = line.rstrip("\n").split("\t")
-    runs[(f[0], f[1])].append(f[3:])
+    runs[(f[0], f[1])].append([x for x in f[3:] if not x.startswith("(")])
 for (renderer, strategy), rs in runs.items():
     cols = []
     for i in range(len(rs[0])):

@@ -192,7 +192,7 @@ fn run_round(
     let open: Vec<&dyn Effect> = effects::ALL
         .iter()
         .copied()
-        .filter(|e| !accepted.iter().any(|a| a == e.name()))
+        .filter(|e| !e.set_only() && !accepted.iter().any(|a| a == e.name()))
         .collect();
     let searched: Vec<&dyn Effect> = open.iter().copied().filter(|e| !e.closed_form()).collect();
     let mut refitted = try_effects(fits, model, &searched, round)?.into_iter();

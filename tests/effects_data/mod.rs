@@ -13,21 +13,18 @@ use scenefit::render::{from_spec, render_one};
 use scenefit::scene::{Light, LightKind, Response, Scene, Vignetting};
 use std::path::Path;
 
-/// The effects the diagnosis knows, in the order it tries them, but
-/// `albedo_map`: planting it needs a map file, and one photograph cannot
-/// tell it (tests/albedo_map.rs tries it on sets).
+/// The effects the diagnosis of one photograph knows, in the order it
+/// tries them, but `albedo_map`: planting it needs a map file, and one
+/// photograph cannot tell it (tests/albedo_map.rs tries it on sets).
 pub fn effects() -> Vec<&'static str> {
     set_effects()
         .into_iter()
-        .filter(|&e| !SET_ONLY.contains(&e))
+        .filter(|&e| !scenefit::diagnose::effects::by_name(e).is_some_and(|x| x.set_only()))
         .collect()
 }
 
-/// Effects only a set of photographs can show: each photograph's own
-/// light colour (for one photograph it is the material's colour).
-pub const SET_ONLY: &[&str] = &["light_color"];
-
-/// The effects a generated set plants: [`effects`] and [`SET_ONLY`].
+/// The effects a generated set plants: [`effects`] and those only a set
+/// shows (each photograph's own light colour).
 pub fn set_effects() -> Vec<&'static str> {
     scenefit::diagnose::effects::names()
         .into_iter()

@@ -21,6 +21,10 @@ impl Effect for LightColor {
         "light_color"
     }
 
+    fn set_only(&self) -> bool {
+        true
+    }
+
     /// R: a colour factor scales a channel of the render.
     fn features(&self, f: &Features) -> Vec<Vec<f64>> {
         vec![f.render.to_vec()]

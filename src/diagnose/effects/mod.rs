@@ -68,6 +68,13 @@ pub trait Effect: Sync {
         false
     }
 
+    /// True for an effect only a set of photographs can tell apart from
+    /// the model (one photograph's light colour is its material's): the
+    /// diagnosis of one photograph does not try it.
+    fn set_only(&self) -> bool {
+        false
+    }
+
     /// True when it can be added to `scene`.
     fn applies(&self, scene: &Scene) -> bool {
         if self.closed_form() {
