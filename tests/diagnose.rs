@@ -1,5 +1,5 @@
 //! `scenefit diagnose` on generated data (tests/effects_data): the first
-//! accepted effect is the planted one for at least 8 of the 9 effects, the
+//! accepted effect is the planted one for all but one of the effects, the
 //! deviation falls to at most half for every one, noise-only targets
 //! accept nothing, and the diagnosis does not depend on `--jobs`.
 
@@ -84,8 +84,13 @@ fn first_accepted_effect_is_the_planted_one() {
             );
         }
     }
-    // Measured 9 of 9, every ratio <= 0.16: docs/results.md.
-    assert!(right >= 8, "{right} of 9 right:\n{}", lines.join("\n"));
+    // Measured: docs/results.md.
+    let n = lines.len();
+    assert!(
+        right + 1 >= n,
+        "{right} of {n} right:\n{}",
+        lines.join("\n")
+    );
     let worst = ratios.iter().copied().fold(0.0, f64::max);
     assert!(
         worst <= 0.5,

@@ -53,6 +53,7 @@ fn neutral_values_render_identically() {
         for o in &mut s.objects {
             o.material.fresnel = Some(1.0);
             o.material.specular2 = Some(0.0);
+            o.material.diffuse_f90 = Some(1.0);
         }
         let img2 = render(&s);
         // The general passes round differently in f32: at most one code.
@@ -97,6 +98,10 @@ fn each_effect_changes_the_image() {
         ),
         ("radius", Box::new(|s| s.lights[0].radius = 0.6)),
         ("indirect", Box::new(|s| s.indirect_light = Some(1.0))),
+        (
+            "grazing",
+            Box::new(|s| s.objects[0].material.diffuse_f90 = Some(0.2)),
+        ),
         (
             "fresnel",
             Box::new(|s| s.objects[0].material.fresnel = Some(0.05)),
@@ -153,4 +158,57 @@ fn effect_fields_are_free_able_and_absent_ones_are_refused() {
         .unwrap_err()
         .to_string();
     assert!(e.contains("fresnel"), "{e}");
+}
+
+/// A matte ball lit from the camera (orthographic, so N·L = N·V = c at
+/// every pixel): with `diffuse_f90` f each pixel's linear value is the
+/// Lambertian one × (1 + (f − 1)(1 − c)⁵)², c read from the Lambertian
+/// render itself (its value over the centre's).
+#[test]
+fn the_grazing_factor_scales_the_diffuse_term_as_stated() {
+    let text = r#"{"format": "scenefit-scene/1", "image": {"width": 96, "height": 96},
+        "camera": {"type": "orthographic", "position": [0, 0, 5], "look_at": [0, 0, 0],
+                   "up": [0, 1, 0], "height": 1.2},
+        "ambient": [0, 0, 0],
+        "lights": [{"name": "sun", "type": "directional", "direction": [0, 0, 1],
+                    "color": [1, 1, 1], "intensity": 2.5}],
+        "objects": [{"name": "ball", "shape": {"type": "sphere", "center": [0, 0, 0], "radius": 0.5},
+                     "material": {"color": [0.8, 0.8, 0.8], "specular": 0}}]}"#;
+    let base = parse(text, "ball.json", &[]).unwrap();
+    let linear = |img: &Image| -> Vec<f64> {
+        img.as_raw()
+            .chunks(3)
+            .map(|p| scenefit::render::srgb::decode(p[1]))
+            .collect()
+    };
+    let lambert = linear(&render(&base));
+    let peak = lambert.iter().copied().fold(0.0, f64::max);
+    assert!(peak > 0.5 && peak < 0.99, "peak {peak}");
+    for f in [0.0, 0.5, 2.0] {
+        let mut s = base.clone();
+        s.objects[0].material.diffuse_f90 = Some(f);
+        let got = linear(&render(&s));
+        let mut checked = 0;
+        for (&l, &g) in lambert.iter().zip(&got) {
+            // Where one 8-bit step is small against the value.
+            if l < 0.1 * peak {
+                continue;
+            }
+            let c = (l / peak).min(1.0);
+            let want = l * (1.0 + (f - 1.0) * (1.0 - c).powi(5)).powi(2);
+            assert!(
+                (g - want).abs() <= 0.01 + 0.03 * want,
+                "f90 {f}, cos {c:.3}: {g:.4} against {want:.4}"
+            );
+            checked += 1;
+        }
+        assert!(checked > 3000, "{checked} pixels checked");
+    }
+    // Out of range: refused naming the file and the key.
+    let mut v: serde_json::Value = serde_json::from_str(text).unwrap();
+    v["objects"][0]["material"]["diffuse_f90"] = serde_json::json!(-0.5);
+    let e = parse(&v.to_string(), "ball.json", &[])
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("ball.json") && e.contains("diffuse_f90"), "{e}");
 }

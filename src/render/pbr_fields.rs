@@ -8,8 +8,9 @@
 //! Refused: a Mitsuba area light (`radius` > 0: a shape with an area
 //! emitter) with a falloff other than 1/d^2, and `fresnel` or `specular2` on a
 //! transmitting material (glass is drawn by the principled BSDF, with its
-//! own Fresnel term and one lobe), and `albedo_map` (a map in the image's
-//! frame, drawn by the built-in tracer only). `indirect_light` is the built-in
+//! own Fresnel term and one lobe), `albedo_map` (a map in the image's
+//! frame, drawn by the built-in tracer only) and `diffuse_f90` other than 1
+//! (the built-in tracer's grazing factor of the diffuse term). `indirect_light` is the built-in
 //! tracer's stand-in for what `render.indirect` traces: not refused.
 
 use crate::error::{Error, Result};
@@ -43,6 +44,12 @@ pub fn check(scene: &Scene, backend: &str) -> Result<()> {
                 "an albedo map in the image's frame is drawn by phong only; use phong",
             );
         }
+        if m.diffuse_f90.is_some_and(|f| f != 1.0) {
+            return refuse(
+                format!("objects.{}.material.diffuse_f90", o.name),
+                "the grazing factor of the diffuse term is drawn by phong only; use phong",
+            );
+        }
         if m.transmission <= 0.0 {
             continue;
         }
@@ -60,4 +67,23 @@ pub fn check(scene: &Scene, backend: &str) -> Result<()> {
         }
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_grazing_factor_is_refused_by_every_other_backend_naming_the_field() {
+        let mut scene = crate::scene::test_scene::ball(r#""color": [0.5, 0.5, 0.5]"#, "");
+        scene.objects[0].material.diffuse_f90 = Some(1.0);
+        assert!(check(&scene, "mitsuba").is_ok(), "1 is Lambertian");
+        scene.objects[0].material.diffuse_f90 = Some(0.4);
+        for backend in ["blender", "mitsuba"] {
+            let e = check(&scene, backend).unwrap_err().to_string();
+            assert!(e.contains("material.diffuse_f90"), "{e}");
+        }
+        let e = crate::render::pov_sdl::check(&scene).unwrap_err();
+        assert!(e.contains("material.diffuse_f90"), "{e}");
+    }
 }

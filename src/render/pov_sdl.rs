@@ -25,7 +25,7 @@
 //! - names: never written (comments say `lights[i]`, `objects[i]`): the
 //!   SDL holds only numbers and fixed keywords, whatever a scene contains.
 //! - refused (a clear error): a directional light's `radius`, a material's
-//!   `fresnel` (other than 1), `specular2` on glass, `albedo_map`. `indirect_light` (the
+//!   `fresnel` (other than 1), `diffuse_f90` (other than 1), `specular2` on glass, `albedo_map`. `indirect_light` (the
 //!   built-in tracer's estimate) is not used: `render.indirect` is POV-Ray's.
 //! - material (kd, ks, n, kr, kt, ior; T = min(kt, MAX_TRANSMIT)):
 //!   pigment `rgbt <color, T>`; finish `ambient kd/(1-T)`,
@@ -111,6 +111,12 @@ pub fn check(scene: &Scene) -> Result<(), String> {
         if m.fresnel.is_some_and(|f| f != 1.0) {
             return Err(format!(
                 "objects.{}.material.fresnel: not supported (POV-Ray's specular highlight has no Fresnel term); use phong, blender or mitsuba",
+                o.name
+            ));
+        }
+        if m.diffuse_f90.is_some_and(|f| f != 1.0) {
+            return Err(format!(
+                "objects.{}.material.diffuse_f90: not supported (POV-Ray's diffuse term is Lambertian); use phong",
                 o.name
             ));
         }

@@ -4,7 +4,7 @@
 //! that value in any copy of the scene without string matching.
 //!
 //! The optional effect fields (`indirect_light`, `lights.NAME.falloff_power`,
-//! `objects.NAME.material.fresnel|specular2|shininess2`,
+//! `objects.NAME.material.fresnel|specular2|shininess2|diffuse_f90`,
 //! `camera.vignetting.strength`, `camera.response.gain|gamma|black`) resolve
 //! only when the scene has them: set them first, then free them.
 
@@ -43,6 +43,7 @@ pub enum MaterialField {
     Fresnel,
     Specular2,
     Shininess2,
+    DiffuseF90,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -142,6 +143,7 @@ impl Field {
                     MaterialField::Fresnel => Scalar(m.fresnel?),
                     MaterialField::Specular2 => Scalar(m.specular2?),
                     MaterialField::Shininess2 => Scalar(m.shininess2?),
+                    MaterialField::DiffuseF90 => Scalar(m.diffuse_f90?),
                 }
             }
             Field::Shape(i, f) => {
@@ -276,6 +278,7 @@ impl MaterialField {
             MaterialField::Fresnel => "fresnel",
             MaterialField::Specular2 => "specular2",
             MaterialField::Shininess2 => "shininess2",
+            MaterialField::DiffuseF90 => "diffuse_f90",
         }
     }
 }
@@ -362,11 +365,15 @@ fn material_field(scene: &Scene, name: &str, field: &str, path: &str) -> Result<
         "fresnel" => MaterialField::Fresnel,
         "specular2" => MaterialField::Specular2,
         "shininess2" => MaterialField::Shininess2,
-        other => return Err(format!("a material has no field \"{other}\" (expected color, diffuse, specular, shininess, reflection, transmission, ior, fresnel, specular2 or shininess2)")),
+        "diffuse_f90" => MaterialField::DiffuseF90,
+        other => return Err(format!("a material has no field \"{other}\" (expected color, diffuse, specular, shininess, reflection, transmission, ior, fresnel, specular2, shininess2 or diffuse_f90)")),
     };
     if matches!(
         f,
-        MaterialField::Fresnel | MaterialField::Specular2 | MaterialField::Shininess2
+        MaterialField::Fresnel
+            | MaterialField::Specular2
+            | MaterialField::Shininess2
+            | MaterialField::DiffuseF90
     ) {
         return present(scene, Field::Material(i, f), path);
     }
@@ -485,6 +492,7 @@ fn set_material(m: &mut super::types::Material, f: MaterialField, value: Value) 
         MaterialField::Fresnel => os(&mut m.fresnel, value),
         MaterialField::Specular2 => os(&mut m.specular2, value),
         MaterialField::Shininess2 => os(&mut m.shininess2, value),
+        MaterialField::DiffuseF90 => os(&mut m.diffuse_f90, value),
     }
 }
 

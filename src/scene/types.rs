@@ -286,6 +286,12 @@ pub struct Material {
     pub specular2: Option<f64>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub shininess2: Option<f64>,
+    /// The diffuse term's factor at grazing angles (Burley's F_D90): the
+    /// diffuse term × (1 + (f90 − 1)(1 − cos θl)⁵)(1 + (f90 − 1)(1 − cos θv)⁵);
+    /// below 1 a smooth dielectric's darkening, above 1 a rough
+    /// surface's brightening, 1 = Lambertian.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub diffuse_f90: Option<f64>,
     /// An OpenEXR image of the camera's size multiplying the diffuse
     /// colour per pixel, in the image's frame (`albedo_map.rs`); made
     /// absolute when the scene is read.

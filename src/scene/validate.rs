@@ -476,6 +476,9 @@ fn material(m: &Material, file: &str, at: &str) -> Result<()> {
     if let Some(k) = m.specular2 {
         non_negative(file, &key("specular2"), k)?;
     }
+    if let Some(f) = m.diffuse_f90 {
+        non_negative(file, &key("diffuse_f90"), f)?;
+    }
     if let Some(n) = m.shininess2 {
         positive(file, &key("shininess2"), n)?;
     }

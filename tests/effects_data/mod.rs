@@ -110,6 +110,12 @@ pub fn plant(truth: &mut Scene, effect: &str, strength: f64) {
                 o.material.fresnel = Some(0.04_f64.powf(strength));
             }
         }
+        "grazing_diffuse" => {
+            // A smooth dielectric's diffuse term, fading towards grazing.
+            for o in &mut truth.objects {
+                o.material.diffuse_f90 = Some(1.0 - 0.8 * strength);
+            }
+        }
         "specular_lobe" => {
             truth.objects[0].material.specular2 = Some(0.8 * strength);
             truth.objects[0].material.shininess2 = Some(4.0);

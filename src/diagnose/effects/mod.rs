@@ -12,6 +12,7 @@ mod area_light;
 mod camera_response;
 pub mod edit;
 mod fresnel;
+mod grazing_diffuse;
 mod indirect_light;
 mod light_color;
 mod light_falloff;
@@ -96,6 +97,7 @@ pub static ALL: &[&dyn Effect] = &[
     &indirect_light::IndirectLight,
     &fresnel::Fresnel,
     &specular_lobe::SpecularLobe,
+    &grazing_diffuse::GrazingDiffuse,
     &light_color::LightColor,
     &albedo_map::AlbedoMap,
 ];

@@ -203,6 +203,46 @@ fn unshadowed(
     sum
 }
 
+/// Adds one light's diffuse term over `range` with Burley's grazing factor
+/// (Physically Based Shading at Disney, 2012; F_D90 held constant): `k` ×
+/// E × (1 + (f90 − 1)(1 − N.L)⁵)(1 + (f90 − 1)(1 − N.V)⁵). The factor is 1
+/// at normal incidence, so `color` keeps its meaning; below 1 towards the
+/// terminator and the silhouette a smooth dielectric's diffuse fades (the
+/// light crosses its surface twice), above 1 a rough surface's brightens.
+#[allow(clippy::too_many_arguments)]
+pub fn grazing_diffuse(
+    pk: &Packed,
+    range: std::ops::Range<usize>,
+    f90: f32,
+    point: bool,
+    light: [f32; 3],
+    k: [f32; 3],
+    e: &[f32],
+    r: &mut [f32],
+    g: &mut [f32],
+    b: &mut [f32],
+) {
+    let grazing = |c: f32| 1.0 + (f90 - 1.0) * (1.0 - c.clamp(0.0, 1.0)).powi(5);
+    for i in range {
+        if e[i] <= 0.0 {
+            continue;
+        }
+        let (mut lx, mut ly, mut lz) = (light[0], light[1], light[2]);
+        if point {
+            let (tx, ty, tz) = (lx - pk.px[i], ly - pk.py[i], lz - pk.pz[i]);
+            let inv = 1.0 / (tx * tx + ty * ty + tz * tz).sqrt();
+            (lx, ly, lz) = (tx * inv, ty * inv, tz * inv);
+        }
+        let (nx, ny, nz) = (pk.nx[i], pk.ny[i], pk.nz[i]);
+        let nl = nx * lx + ny * ly + nz * lz;
+        let nv = nx * pk.vx[i] + ny * pk.vy[i] + nz * pk.vz[i];
+        let d = e[i] * grazing(nl) * grazing(nv);
+        r[i] += d * k[0];
+        g[i] += d * k[1];
+        b[i] += d * k[2];
+    }
+}
+
 /// A material's specular lobes, normalised as in `shade.rs`.
 pub struct Lobes {
     pub spec: f32,

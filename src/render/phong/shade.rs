@@ -14,7 +14,8 @@
 //! `falloff_power` p (E ~ 1/d^p), a light's `radius` (soft shadows from
 //! several shadow rays, `effects.rs`), the material's `fresnel` F0 (the
 //! lobe scaled by Schlick's F(H.V)/F0) and second lobe (`specular2`,
-//! `shininess2`), the material's `albedo_map` (the diffuse and ambient
+//! `shininess2`), the diffuse term's grazing factor `diffuse_f90`
+//! (Burley's), the material's `albedo_map` (the diffuse and ambient
 //! terms of a camera ray's first hit times the map at its pixel; what
 //! mirrors, glass and the one-bounce estimate see is not mapped), and the
 //! scene's `indirect_light` (a one-bounce estimate).
@@ -68,6 +69,8 @@ struct Mat {
     /// The second lobe, normalised like the first, and its exponent.
     spec2: f32,
     shininess2: f32,
+    /// Burley's F_D90 of the diffuse term, when not 1.
+    f90: Option<f32>,
 }
 
 impl Mat {
@@ -234,6 +237,10 @@ fn add_diffuse(
             m.diffuse[1] * lamp.power[1],
             m.diffuse[2] * lamp.power[2],
         ];
+        if let Some(f90) = m.f90 {
+            super::effects::grazing_diffuse(packed, range, f90, lamp.point, lamp.at, k, e, r, g, b);
+            continue;
+        }
         accumulate(
             &e[range.clone()],
             k,
@@ -400,6 +407,7 @@ fn materials(scene: &Scene) -> Vec<Mat> {
                     k * (m.shininess2.unwrap_or(m.shininess) + 8.0) / (8.0 * PI)
                 }) as f32,
                 shininess2: m.shininess2.unwrap_or(m.shininess) as f32,
+                f90: m.diffuse_f90.filter(|&f| f != 1.0).map(|f| f as f32),
             }
         })
         .collect()
