@@ -125,6 +125,10 @@ fn fit_args<'a>(out: &'a str, renderer: &'a str, generations: &'a str) -> Vec<&'
         "8",
         "--generations",
         generations,
+        // The whole budget, whatever the start: the hybrid may converge
+        // within a second, before a worker can be cancelled mid-run.
+        "--strategy",
+        "shade",
         "--jobs",
         "2",
         "-q",
@@ -218,7 +222,9 @@ fn plugin_fit_on_slurm_matches_local_despite_a_cancelled_worker() {
     if !have_slurm() || !have("python3", "python3") {
         return;
     }
-    same_fit_on_slurm(&lambert_worker(), 64, 48, "12");
+    // 40 generations: about 5 s on Slurm here (12 took 1.5 s, as long as
+    // the test waits before it cancels a worker).
+    same_fit_on_slurm(&lambert_worker(), 64, 48, "40");
 }
 
 #[test]
