@@ -23,9 +23,10 @@ use crate::error::{Error, Result};
 use crate::fit::set::shots::Shot;
 use crate::metric::Mask;
 use crate::raster::Image;
+use crate::render::camera_effects;
 use crate::render::render_one;
 use crate::scene::albedo_map::{self, AlbedoMap};
-use crate::scene::{ParamSpace, Response, ResponseEncoding, Scene};
+use crate::scene::{ParamSpace, Response, Scene};
 use std::path::{Path, PathBuf};
 
 /// The effect's name in diagnosis.json.
@@ -83,30 +84,16 @@ struct Levels {
 
 impl Levels {
     fn new(response: Option<Response>) -> Levels {
-        let r = response.unwrap_or_default();
+        let response = response.unwrap_or_default();
         let linear = (0..=255u8)
-            .map(|v| {
-                let x = match r.encoding {
-                    ResponseEncoding::Srgb => crate::render::srgb::decode(v),
-                    ResponseEncoding::Linear => v as f64 / 255.0,
-                };
-                ((x - r.black).max(0.0) / r.gain.max(1e-9)).powf(1.0 / r.gamma.max(1e-3))
-            })
+            .map(|v| camera_effects::linear(&response, v))
             .collect();
-        Levels {
-            response: r,
-            linear,
-        }
+        Levels { response, linear }
     }
 
     /// The level written for the linear value `x`.
     fn level(&self, x: f64) -> u8 {
-        let r = &self.response;
-        let y = r.black + r.gain * x.max(0.0).powf(r.gamma);
-        match r.encoding {
-            ResponseEncoding::Srgb => crate::render::srgb::encode_exact(y),
-            ResponseEncoding::Linear => (y.clamp(0.0, 1.0) * 255.0).round() as u8,
-        }
+        camera_effects::level(&self.response, x)
     }
 }
 
@@ -419,6 +406,7 @@ pub fn set_model(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::scene::ResponseEncoding;
 
     #[test]
     fn the_weighted_median_follows_the_weights() {

@@ -22,7 +22,7 @@ use super::srgb::encode;
 use super::srgb::{decode, encode_exact};
 use super::{Image, RenderResult, RenderSession, Renderer};
 use crate::error::Result;
-use crate::scene::{Camera, ParamSpace, ResponseEncoding, Scene};
+use crate::scene::{Camera, ParamSpace, Response, ResponseEncoding, Scene};
 
 /// Any renderer, followed by the camera's image-space effects.
 pub struct WithCameraEffects(pub Box<dyn Renderer>);
@@ -99,6 +99,22 @@ fn writer(encoding: ResponseEncoding) -> fn(f64) -> u8 {
     }
 }
 
+/// The 8-bit level `r` writes for the linear value `x`: the curve
+/// `black + gain x^gamma`, then its encoding.
+pub fn level(r: &Response, x: f64) -> u8 {
+    writer(r.encoding)(r.black + r.gain * x.max(0.0).powf(r.gamma))
+}
+
+/// The linear value behind the 8-bit level `v` under `r`: the encoding and
+/// the curve undone (a level below `black` gives 0).
+pub fn linear(r: &Response, v: u8) -> f64 {
+    let y = match r.encoding {
+        ResponseEncoding::Srgb => decode(v),
+        ResponseEncoding::Linear => v as f64 / 255.0,
+    };
+    ((y - r.black).max(0.0) / r.gain.max(1e-9)).powf(1.0 / r.gamma.max(1e-3))
+}
+
 /// Applies the camera's vignetting and response to `img` in place.
 pub fn apply(cam: &Camera, img: &mut Image) {
     if !has_effects(cam) {
@@ -116,9 +132,8 @@ pub fn apply(cam: &Camera, img: &mut Image) {
         // input alone: a table per channel instead of two powers per value
         // (the difference between ~600 and ~6,000 renders/s at 128x96).
         let lut = decoded();
-        let write = writer(resp.encoding);
-        let curve = |v: f64| write(resp.black + resp.gain * v.max(0.0).powf(resp.gamma));
-        let tables = balance.map(|b| -> [u8; 256] { std::array::from_fn(|i| curve(lut[i] * b)) });
+        let tables =
+            balance.map(|b| -> [u8; 256] { std::array::from_fn(|i| level(&resp, lut[i] * b)) });
         for px in img.pixels_mut() {
             for (c, t) in px.0.iter_mut().zip(&tables) {
                 *c = t[*c as usize];

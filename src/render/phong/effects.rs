@@ -203,6 +203,22 @@ fn unshadowed(
     sum
 }
 
+/// The unit vector from hit `i` towards a light at `light` (a point light)
+/// or along `light` (a directional one, already unit).
+#[inline(always)]
+fn to_light(pk: &Packed, i: usize, point: bool, light: [f32; 3]) -> (f32, f32, f32) {
+    if !point {
+        return (light[0], light[1], light[2]);
+    }
+    let (tx, ty, tz) = (
+        light[0] - pk.px[i],
+        light[1] - pk.py[i],
+        light[2] - pk.pz[i],
+    );
+    let inv = 1.0 / (tx * tx + ty * ty + tz * tz).sqrt();
+    (tx * inv, ty * inv, tz * inv)
+}
+
 /// Adds one light's diffuse term over `range` with Burley's grazing factor
 /// (Physically Based Shading at Disney, 2012; F_D90 held constant): `k` ×
 /// E × (1 + (f90 − 1)(1 − N.L)⁵)(1 + (f90 − 1)(1 − N.V)⁵). The factor is 1
@@ -227,12 +243,7 @@ pub fn grazing_diffuse(
         if e[i] <= 0.0 {
             continue;
         }
-        let (mut lx, mut ly, mut lz) = (light[0], light[1], light[2]);
-        if point {
-            let (tx, ty, tz) = (lx - pk.px[i], ly - pk.py[i], lz - pk.pz[i]);
-            let inv = 1.0 / (tx * tx + ty * ty + tz * tz).sqrt();
-            (lx, ly, lz) = (tx * inv, ty * inv, tz * inv);
-        }
+        let (lx, ly, lz) = to_light(pk, i, point, light);
         let (nx, ny, nz) = (pk.nx[i], pk.ny[i], pk.nz[i]);
         let nl = nx * lx + ny * ly + nz * lz;
         let nv = nx * pk.vx[i] + ny * pk.vy[i] + nz * pk.vz[i];
@@ -272,12 +283,7 @@ pub fn specular(
         if e[i] <= 0.0 {
             continue;
         }
-        let (mut lx, mut ly, mut lz) = (light[0], light[1], light[2]);
-        if point {
-            let (tx, ty, tz) = (lx - pk.px[i], ly - pk.py[i], lz - pk.pz[i]);
-            let inv = 1.0 / (tx * tx + ty * ty + tz * tz).sqrt();
-            (lx, ly, lz) = (tx * inv, ty * inv, tz * inv);
-        }
+        let (lx, ly, lz) = to_light(pk, i, point, light);
         let (vx, vy, vz) = (pk.vx[i], pk.vy[i], pk.vz[i]);
         let (hx, hy, hz) = (lx + vx, ly + vy, lz + vz);
         let hl = (hx * hx + hy * hy + hz * hz).sqrt();
