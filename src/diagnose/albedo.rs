@@ -26,7 +26,7 @@ use crate::raster::Image;
 use crate::render::camera_effects;
 use crate::render::render_one;
 use crate::scene::albedo_map::{self, AlbedoMap};
-use crate::scene::{ParamSpace, Response, Scene};
+use crate::scene::{Response, Scene};
 use std::path::{Path, PathBuf};
 
 /// The effect's name in diagnosis.json.
@@ -325,9 +325,8 @@ pub fn candidate(
             (fitted, count) = (m, count2);
         }
     }
-    let k0 = ParamSpace::from_scene(&model.scene).dim();
     let refit = "closed form, then warm";
-    let c = Candidate::scored(NAME, round, fits.inputs, model, &fitted, k0, count, refit);
+    let c = Candidate::scored(NAME, round, fits.inputs, model, &fitted, count, refit);
     Ok(Some((c, fitted)))
 }
 

@@ -42,7 +42,7 @@ use crate::scene::{ParamSpace, Scene};
 use effects::Effect;
 use refit::{Model, Refine, Refits, Search};
 use residual::Residual;
-use selection::{bic, samples};
+use selection::samples;
 use serde::Serialize;
 use std::path::Path;
 use std::time::Instant;
@@ -56,8 +56,12 @@ pub struct Candidate {
     /// The deviation after its refit (None: not applicable).
     pub deviation_after: Option<Deviation>,
     pub round: usize,
-    /// BIC after its refit minus BIC of the model it extends.
+    /// BIC after its refit minus BIC of the model it extends, with the
+    /// round's overdispersion (`selection.rs`).
     pub delta_bic: Option<f64>,
+    /// ĉ of the round: how much less than independent samples its pixels
+    /// count for (1: independent).
+    pub overdispersion: Option<f64>,
     /// Relative drop of the sum of absolute differences.
     pub gain: Option<f64>,
     pub added_params: usize,
@@ -67,21 +71,18 @@ pub struct Candidate {
 }
 
 impl Candidate {
-    /// The candidate of an effect whose refit of `model` (with `k0` free
-    /// values) gave `fitted` with `added` more: its deviation, BIC change
-    /// and gain on one photograph; evidence left at 0 for the caller.
-    #[allow(clippy::too_many_arguments)]
+    /// The candidate of an effect whose refit of `model` gave `fitted`
+    /// with `added` more free values: its deviation and gain on one
+    /// photograph; evidence and BIC change left for the round.
     fn scored(
         effect: &str,
         round: usize,
         inputs: &Inputs,
         model: &Model,
         fitted: &Model,
-        k0: usize,
         added: usize,
         refit: &str,
     ) -> Candidate {
-        let n = samples(&inputs.target, inputs.mask.as_ref());
         Candidate {
             effect: effect.to_string(),
             evidence: 0.0,
@@ -91,7 +92,8 @@ impl Candidate {
                 inputs.mask.as_ref(),
             )),
             round,
-            delta_bic: Some(bic(fitted.sad, n, k0 + added) - bic(model.sad, n, k0)),
+            delta_bic: None,
+            overdispersion: None,
             gain: Some(1.0 - fitted.sad / model.sad.max(1e-9)),
             added_params: added,
             accepted: false,
@@ -212,6 +214,13 @@ fn run_round(
     }
     tried.sort_by(|a, b| b.0.evidence.total_cmp(&a.0.evidence));
     let (mut candidates, models): (Vec<Candidate>, Vec<Model>) = tried.into_iter().unzip();
+    if let Some(general) = models.iter().min_by(|a, b| a.sad.total_cmp(&b.sad)) {
+        let mask = inputs.mask.as_ref();
+        let c = selection::overdispersion([(&inputs.target, &general.image, mask)]);
+        let n = samples(&inputs.target, mask);
+        let sads: Vec<f64> = models.iter().map(|m| m.sad).collect();
+        selection::weigh(&mut candidates, &sads, model.sad, n, c);
+    }
     let chosen = selection::choose(&candidates, fits.config);
     let accepted = chosen.and_then(|i| {
         candidates[i].accepted = true;
@@ -232,8 +241,7 @@ struct Trial {
     /// The entries its own search moves.
     search: Vec<crate::scene::FreeParam>,
     radius: f64,
-    /// Free values before, and added.
-    k0: usize,
+    /// Free values added.
     added: usize,
 }
 
@@ -309,7 +317,6 @@ fn try_effects(
                     fits.inputs,
                     model,
                     &fitted,
-                    t.k0,
                     t.added,
                     refit,
                 );
@@ -334,7 +341,6 @@ fn prepare(fits: &mut Refits, model: &Model, effect: &'static dyn Effect) -> Res
             search: trades.search(&start, &ext.added),
             radius: trades.radius,
             start,
-            k0,
             added,
         });
     }

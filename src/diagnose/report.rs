@@ -153,6 +153,7 @@ fn candidates(page: &mut Page, d: &Diagnosis) {
             "evidence (R²)",
             "params added",
             "ΔBIC",
+            "ĉ",
             "SAD drop",
             "deviation after",
             "refit",
@@ -176,6 +177,7 @@ fn candidate_row(c: &super::Candidate) -> Vec<String> {
         format!("{:.3}", c.evidence),
         c.added_params.to_string(),
         c.delta_bic.map_or("-".into(), |v| format!("{v:.1}")),
+        c.overdispersion.map_or("-".into(), |v| format!("{v:.2}")),
         c.gain.map_or("-".into(), |v| format!("{:.1} %", 100.0 * v)),
         c.deviation_after
             .map_or("-".into(), |v| format!("{:.3}", v.average)),
@@ -203,6 +205,7 @@ mod tests {
             deviation_after: Some(dev(0.01)),
             round: 1,
             delta_bic: Some(-123.45),
+            overdispersion: Some(1.0),
             gain: Some(0.5),
             added_params: 1,
             accepted: true,

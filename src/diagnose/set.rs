@@ -15,7 +15,7 @@
 
 use super::effects::{self, Effect};
 use super::residual::Residual;
-use super::selection::{bic, choose, sad, samples};
+use super::selection::{choose, overdispersion, sad, samples, weigh};
 use super::{Candidate, DiagnoseConfig, Diagnosis, UNEXPLAINED};
 use crate::error::{Error, Result};
 use crate::fit::set::shots::Shot;
@@ -564,7 +564,8 @@ fn rounds(
                 evidence: evidence(&residuals, effect),
                 deviation_after: Some(pooled(&fitted.deviations(inputs), inputs)),
                 round,
-                delta_bic: Some(bic(fitted.sad, n, k) - bic(model.sad, n, k0)),
+                delta_bic: None,
+                overdispersion: None,
                 gain: Some(1.0 - fitted.sad / model.sad.max(1e-9)),
                 added_params: k.saturating_sub(k0),
                 accepted: false,
@@ -574,6 +575,17 @@ fn rounds(
         }
         tried.sort_by(|a, b| b.0.evidence.total_cmp(&a.0.evidence));
         let (mut found, models): (Vec<Candidate>, Vec<SetModel>) = tried.into_iter().unzip();
+        if let Some(general) = models.iter().min_by(|a, b| a.sad.total_cmp(&b.sad)) {
+            let c = overdispersion(
+                general
+                    .images
+                    .iter()
+                    .zip(&inputs.shots)
+                    .map(|(img, s)| (&s.target.image, img, s.target.mask.as_ref())),
+            );
+            let sads: Vec<f64> = models.iter().map(|m| m.sad).collect();
+            weigh(&mut found, &sads, model.sad, n, c);
+        }
         let chosen = choose(&found, fits.config);
         if let Some(i) = chosen {
             found[i].accepted = true;
