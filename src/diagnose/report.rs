@@ -232,7 +232,7 @@ mod tests {
             "src=\"residual_before.png\"",
             "src=\"residual_after.png\"",
             "<td>0.457</td>",
-            "<td>-123.5</td><td>50.0 %</td><td>0.010</td><td class=\"l\">from scratch</td><td class=\"l\">yes</td>",
+            "<td>-123.5</td><td>1.00</td><td>50.0 %</td><td>0.010</td><td class=\"l\">from scratch</td><td class=\"l\">yes</td>",
             "<td class=\"l\">camera.vignetting.strength</td><td>0.4</td>",
         ] {
             assert!(page.contains(part), "missing {part}:\n{page}");
