@@ -575,17 +575,7 @@ fn rounds(
         }
         tried.sort_by(|a, b| b.0.evidence.total_cmp(&a.0.evidence));
         let (mut found, models): (Vec<Candidate>, Vec<SetModel>) = tried.into_iter().unzip();
-        if let Some(general) = models.iter().min_by(|a, b| a.sad.total_cmp(&b.sad)) {
-            let c = overdispersion(
-                general
-                    .images
-                    .iter()
-                    .zip(&inputs.shots)
-                    .map(|(img, s)| (&s.target.image, img, s.target.mask.as_ref())),
-            );
-            let sads: Vec<f64> = models.iter().map(|m| m.sad).collect();
-            weigh(&mut found, &sads, model.sad, n, c);
-        }
+        weigh_round(&mut found, &models, model.sad, n, inputs);
         let chosen = choose(&found, fits.config);
         if let Some(i) = chosen {
             found[i].accepted = true;
@@ -606,6 +596,25 @@ fn rounds(
         }
     }
     Ok((candidates, accepted))
+}
+
+/// The round's criterion changes from a model with SAD `sad0`, with the
+/// overdispersion of the most general model tried (the lowest SAD) over
+/// every photograph.
+fn weigh_round(
+    found: &mut [Candidate],
+    models: &[SetModel],
+    sad0: f64,
+    n: f64,
+    inputs: &SetInputs,
+) {
+    let Some(general) = models.iter().min_by(|a, b| a.sad.total_cmp(&b.sad)) else {
+        return;
+    };
+    let pairs = general.images.iter().zip(&inputs.shots);
+    let c = overdispersion(pairs.map(|(img, s)| (&s.target.image, img, s.target.mask.as_ref())));
+    let sads: Vec<f64> = models.iter().map(|m| m.sad).collect();
+    weigh(found, &sads, sad0, n, c);
 }
 
 /// Every form of every effect in `searched` added to `model` and refitted
