@@ -139,16 +139,7 @@ pub fn solve(evidence: &[Evidence], response: Option<Response>) -> Solved {
     // Which pixels each photograph counts.
     let inside: Vec<Vec<bool>> = evidence
         .iter()
-        .map(|e| match e.mask {
-            Some(m) => {
-                let mut v = vec![false; (w * h) as usize];
-                for &p in m.pixels() {
-                    v[p as usize] = true;
-                }
-                v
-            }
-            None => vec![true; (w * h) as usize],
-        })
+        .map(|e| Mask::counted(e.mask, (w * h) as usize))
         .collect();
     // The criterion's N and SAD for the model without the map.
     let (mut n, mut sad) = (0.0_f64, 0.0);

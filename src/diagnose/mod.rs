@@ -214,13 +214,12 @@ fn run_round(
     }
     tried.sort_by(|a, b| b.0.evidence.total_cmp(&a.0.evidence));
     let (mut candidates, models): (Vec<Candidate>, Vec<Model>) = tried.into_iter().unzip();
-    if let Some(general) = models.iter().min_by(|a, b| a.sad.total_cmp(&b.sad)) {
-        let mask = inputs.mask.as_ref();
-        let c = selection::overdispersion([(&inputs.target, &general.image, mask)]);
-        let n = samples(&inputs.target, mask);
-        let sads: Vec<f64> = models.iter().map(|m| m.sad).collect();
-        selection::weigh(&mut candidates, &sads, model.sad, n, c);
-    }
+    let mask = inputs.mask.as_ref();
+    let n = samples(&inputs.target, mask);
+    let sads: Vec<f64> = models.iter().map(|m| m.sad).collect();
+    selection::weigh(&mut candidates, &sads, model.sad, n, |i| {
+        selection::overdispersion([(&inputs.target, &models[i].image, mask)])
+    });
     let chosen = selection::choose(&candidates, fits.config);
     let accepted = chosen.and_then(|i| {
         candidates[i].accepted = true;

@@ -47,9 +47,20 @@ pub fn delta_bic(sad0: f64, sad1: f64, n: f64, added: usize, c: f64) -> f64 {
 }
 
 /// Each candidate's criterion change from the model with SAD `sad0`, its
-/// refit's SAD in `sads` (in order), over `n` channel values with the
-/// round's overdispersion `c`.
-pub fn weigh(candidates: &mut [Candidate], sads: &[f64], sad0: f64, n: f64, c: f64) {
+/// refit's SAD in `sads` (in order), over `n` channel values, with the
+/// round's overdispersion: `overdispersion_of(i)` of the lowest-SAD
+/// candidate `i`, the most general model tried.
+pub fn weigh(
+    candidates: &mut [Candidate],
+    sads: &[f64],
+    sad0: f64,
+    n: f64,
+    overdispersion_of: impl FnOnce(usize) -> f64,
+) {
+    let Some(general) = (0..sads.len()).min_by(|&a, &b| sads[a].total_cmp(&sads[b])) else {
+        return;
+    };
+    let c = overdispersion_of(general);
     for (cand, &sad) in candidates.iter_mut().zip(sads) {
         cand.delta_bic = Some(delta_bic(sad0, sad, n, cand.added_params, c));
         cand.overdispersion = Some(c);
@@ -71,14 +82,7 @@ pub fn overdispersion<'a>(
     let (mut sx, mut sy, mut s0) = (0.0, 0.0, 0.0);
     for (target, render, mask) in pairs {
         let (w, h) = (target.width() as usize, target.height() as usize);
-        let inside = match mask {
-            Some(m) => {
-                let mut v = vec![false; w * h];
-                m.pixels().iter().for_each(|&p| v[p as usize] = true);
-                v
-            }
-            None => vec![true; w * h],
-        };
+        let inside = Mask::counted(mask, w * h);
         let (t, r) = (target.as_raw(), render.as_raw());
         for c in 0..3 {
             let d = |i: usize| t[3 * i + c] as f64 - r[3 * i + c] as f64;

@@ -598,9 +598,8 @@ fn rounds(
     Ok((candidates, accepted))
 }
 
-/// The round's criterion changes from a model with SAD `sad0`, with the
-/// overdispersion of the most general model tried (the lowest SAD) over
-/// every photograph.
+/// The round's criterion changes from a model with SAD `sad0`, the
+/// overdispersion measured over every photograph.
 fn weigh_round(
     found: &mut [Candidate],
     models: &[SetModel],
@@ -608,13 +607,11 @@ fn weigh_round(
     n: f64,
     inputs: &SetInputs,
 ) {
-    let Some(general) = models.iter().min_by(|a, b| a.sad.total_cmp(&b.sad)) else {
-        return;
-    };
-    let pairs = general.images.iter().zip(&inputs.shots);
-    let c = overdispersion(pairs.map(|(img, s)| (&s.target.image, img, s.target.mask.as_ref())));
     let sads: Vec<f64> = models.iter().map(|m| m.sad).collect();
-    weigh(found, &sads, sad0, n, c);
+    weigh(found, &sads, sad0, n, |i| {
+        let pairs = models[i].images.iter().zip(&inputs.shots);
+        overdispersion(pairs.map(|(img, s)| (&s.target.image, img, s.target.mask.as_ref())))
+    });
 }
 
 /// Every form of every effect in `searched` added to `model` and refitted

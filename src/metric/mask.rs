@@ -72,6 +72,21 @@ impl Mask {
         &self.pixels
     }
 
+    /// Whether each of the `len` pixels of an image (row-major) counts:
+    /// all of them without a mask.
+    pub fn counted(mask: Option<&Mask>, len: usize) -> Vec<bool> {
+        let Some(m) = mask else {
+            return vec![true; len];
+        };
+        let mut inside = vec![false; len];
+        for &p in m.pixels() {
+            if let Some(k) = inside.get_mut(p as usize) {
+                *k = true;
+            }
+        }
+        inside
+    }
+
     /// The pixels as runs of consecutive indices: (first, count).
     pub fn runs(&self) -> &[(u32, u32)] {
         &self.runs

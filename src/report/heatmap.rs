@@ -26,13 +26,8 @@ pub fn signed_luminance(target: &Image, render: &Image, mask: Option<&Mask>) -> 
         .zip(render.pixels())
         .map(|(t, r)| Some(lum(t) - lum(r)))
         .collect();
-    if let Some(m) = mask {
-        let mut keep = vec![false; d.len()];
-        for &p in m.pixels() {
-            if let Some(k) = keep.get_mut(p as usize) {
-                *k = true;
-            }
-        }
+    if mask.is_some() {
+        let keep = Mask::counted(mask, d.len());
         for (v, k) in d.iter_mut().zip(keep) {
             if !k {
                 *v = None;
