@@ -218,6 +218,19 @@ fn cases() -> Vec<Case> {
             &["lights[0].falloff_power", "at most 16"],
         ));
     }
+    c.push(render_case(
+        "distance on a point light",
+        |v| v["lights"][0]["distance"] = json!(5.0),
+        &["lights[0].distance", "point light"],
+    ));
+    c.push(render_case(
+        "near light at distance 0",
+        |v| {
+            v["lights"][0] = json!({"name": "sun", "type": "directional",
+                "direction": [0, 1, 0], "intensity": 1.0, "distance": 0.0});
+        },
+        &["lights[0].distance", "positive"],
+    ));
 
     // 9. Numbers: every one within +-1e9, bounds whose span stays finite.
     let numbers: [(&str, SetNumber); 14] = [

@@ -11,6 +11,7 @@ pub mod blender;
 pub mod command;
 pub mod external;
 pub mod mitsuba;
+pub mod near_lights;
 pub mod pbr_fields;
 pub mod pov_sdl;
 pub mod povray;
@@ -99,9 +100,8 @@ pub fn from_spec(spec: &str) -> Result<Box<dyn Renderer>> {
 
 /// `from_spec` with `opts` over the environment and the defaults.
 pub fn from_spec_with(spec: &str, opts: &RenderOptions) -> Result<Box<dyn Renderer>> {
-    Ok(Box::new(camera_effects::WithCameraEffects(backend(
-        spec, opts,
-    )?)))
+    let drawn = near_lights::WithNearLights(backend(spec, opts)?);
+    Ok(Box::new(camera_effects::WithCameraEffects(Box::new(drawn))))
 }
 
 /// The bare backend named by `spec`.

@@ -3,7 +3,7 @@
 //! resolved once against a scene into a `Field`, which then reads and writes
 //! that value in any copy of the scene without string matching.
 //!
-//! The optional effect fields (`indirect_light`, `lights.NAME.falloff_power`,
+//! The optional effect fields (`indirect_light`, `lights.NAME.falloff_power|distance`,
 //! `objects.NAME.material.fresnel|specular2|shininess2|diffuse_f90`,
 //! `camera.vignetting.strength`, `camera.response.gain|gamma|black`) resolve
 //! only when the scene has them: set them first, then free them.
@@ -29,6 +29,7 @@ pub enum LightField {
     Intensity,
     Radius,
     FalloffPower,
+    Distance,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -128,6 +129,7 @@ impl Field {
                     LightField::Intensity => Scalar(l.intensity),
                     LightField::Radius => Scalar(l.radius),
                     LightField::FalloffPower => Scalar(l.falloff_power?),
+                    LightField::Distance => Scalar(l.distance?),
                 }
             }
             Field::Material(i, f) => {
@@ -261,6 +263,7 @@ impl LightField {
             LightField::Intensity => "intensity",
             LightField::Radius => "radius",
             LightField::FalloffPower => "falloff_power",
+            LightField::Distance => "distance",
         }
     }
 }
@@ -343,9 +346,10 @@ fn light_field(scene: &Scene, name: &str, field: &str, path: &str) -> Result<Fie
         "intensity" => LightField::Intensity,
         "radius" => LightField::Radius,
         "falloff_power" => LightField::FalloffPower,
-        other => return Err(format!("a light has no numeric field \"{other}\" (expected position, direction, color, intensity, radius or falloff_power)")),
+        "distance" => LightField::Distance,
+        other => return Err(format!("a light has no numeric field \"{other}\" (expected position, direction, color, intensity, radius, falloff_power or distance)")),
     };
-    if f == LightField::FalloffPower {
+    if matches!(f, LightField::FalloffPower | LightField::Distance) {
         return present(scene, Field::Light(i, f), path);
     }
     Ok(Field::Light(i, f))
@@ -477,6 +481,7 @@ fn set_light(l: &mut super::types::Light, f: LightField, value: Value) {
         LightField::Intensity => s(&mut l.intensity, value),
         LightField::Radius => s(&mut l.radius, value),
         LightField::FalloffPower => os(&mut l.falloff_power, value),
+        LightField::Distance => os(&mut l.distance, value),
     }
 }
 

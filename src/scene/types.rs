@@ -209,6 +209,20 @@ pub struct Light {
     /// Point lights: irradiance falls as 1/d^p (overrides `falloff`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub falloff_power: Option<f64>,
+    /// Directional lights: a near light, at this distance from the origin
+    /// along `direction`, whose irradiance at the origin is `intensity`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub distance: Option<f64>,
+}
+
+impl Light {
+    /// Where a directional light with a `distance` is (`None`: at infinity,
+    /// or a point light).
+    pub fn near_position(&self) -> Option<Vec3> {
+        let (d, dist) = (self.direction?, self.distance?);
+        let n = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+        Some(d.map(|x| x / n * dist))
+    }
 }
 
 fn white() -> Vec3 {

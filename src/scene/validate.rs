@@ -351,12 +351,21 @@ fn light(l: &Light, file: &str, at: &str) -> Result<()> {
             }
             forbidden(
                 file,
+                &format!("{at}.distance"),
+                &l.distance,
+                "a point light (its position says where it is)",
+            )?;
+            forbidden(
+                file,
                 &format!("{at}.direction"),
                 &l.direction,
                 "a point light (use position)",
             )
         }
         LightKind::Directional => {
+            if let Some(d) = l.distance {
+                positive(file, &format!("{at}.distance"), d)?;
+            }
             let d = required(
                 file,
                 &format!("{at}.direction"),

@@ -97,7 +97,9 @@ impl Variation {
                         V3::new(s.max[0], s.max[1], s.max[2]),
                     )
                 }
-                Field::Light(i, LightField::Direction) => lights[i] = LightRange::Turning,
+                Field::Light(i, LightField::Direction | LightField::Distance) => {
+                    lights[i] = LightRange::Turning
+                }
                 Field::Material(i, MaterialField::Reflection) => reflective[i] |= s.max[0] > 0.0,
                 Field::Material(i, MaterialField::Transmission) => {
                     transmissive[i] |= s.max[0] > 0.0
