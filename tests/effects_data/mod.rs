@@ -74,6 +74,31 @@ pub fn base(w: u32, h: u32, variant: u32) -> Scene {
     s
 }
 
+/// `scene` with its key light made directional: from where the point
+/// light was, its irradiance at the origin the same; direction and
+/// intensity free.
+pub fn far_lit(mut scene: Scene) -> Scene {
+    let l = &mut scene.lights[0];
+    let p = l.position.take().unwrap();
+    let d2 = p.iter().map(|x| x * x).sum::<f64>();
+    l.kind = LightKind::Directional;
+    l.direction = Some(p.map(|x| x / d2.sqrt()));
+    l.intensity /= d2;
+    let text = r#"[
+        {"param": "lights.key.direction", "min": [-1, 0, -1], "max": [1, 1, 1]},
+        {"param": "lights.key.intensity", "min": 0.05, "max": 5}
+    ]"#;
+    let mut free: Vec<scenefit::scene::FreeParam> = serde_json::from_str(text).unwrap();
+    free.extend(
+        scene
+            .free
+            .drain(..)
+            .filter(|f| !f.param.starts_with("lights.")),
+    );
+    scene.free = free;
+    scene
+}
+
 /// Plants `effect` at `strength` (1 = the reference strength) into `truth`.
 pub fn plant(truth: &mut Scene, effect: &str, strength: f64) {
     match effect {
@@ -89,6 +114,7 @@ pub fn plant(truth: &mut Scene, effect: &str, strength: f64) {
             falloff: Default::default(),
             radius: 0.0,
             falloff_power: None,
+            distance: None,
         }),
         "area_light" => truth.lights[0].radius = 0.7 * strength,
         "vignetting" => {
@@ -116,6 +142,9 @@ pub fn plant(truth: &mut Scene, effect: &str, strength: f64) {
                 o.material.diffuse_f90 = Some(1.0 - 0.8 * strength);
             }
         }
+        // The lamp the model calls directional, 8 units from the origin
+        // (one and a half times the camera's distance).
+        "near_light" => truth.lights[0].distance = Some(8.0 / strength),
         "specular_lobe" => {
             truth.objects[0].material.specular2 = Some(0.8 * strength);
             truth.objects[0].material.shininess2 = Some(4.0);
@@ -141,7 +170,10 @@ pub fn add_noise(img: &mut Image, sigma: f64, seed: u64) {
 /// The case for `effect` (or "none") on scene `variant`.
 pub fn case(effect: &str, variant: u32, strength: f64, seed: u64, noise: f64) -> Case {
     let (w, h) = (64, 48);
-    let model = base(w, h, if effect == "fresnel" { 1 } else { variant });
+    let mut model = base(w, h, if effect == "fresnel" { 1 } else { variant });
+    if effect == "near_light" {
+        model = far_lit(model);
+    }
     let mut truth = model.clone();
     plant(&mut truth, effect, strength);
     let mut target = render_one(from_spec("phong").unwrap().as_ref(), &truth, 0).unwrap();

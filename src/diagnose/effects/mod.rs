@@ -16,6 +16,7 @@ mod grazing_diffuse;
 mod indirect_light;
 mod light_color;
 mod light_falloff;
+mod near_light;
 mod second_light;
 mod specular_lobe;
 mod vignetting;
@@ -90,6 +91,7 @@ pub trait Effect: Sync {
 pub static ALL: &[&dyn Effect] = &[
     &ambient::Ambient,
     &light_falloff::LightFalloff,
+    &near_light::NearLight,
     &second_light::SecondLight,
     &area_light::AreaLight,
     &vignetting::Vignetting,

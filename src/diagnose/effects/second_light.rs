@@ -63,6 +63,7 @@ impl Effect for SecondLight {
             falloff: key.falloff,
             radius: 0.0,
             falloff_power: None,
+            distance: key.distance,
         };
         if field == LightField::Position {
             light.position = Some(start);
