@@ -2,7 +2,8 @@
 //! implementing [`Effect`] in its own module, and [`ALL`] lists them in the
 //! order the diagnosis tries them. An effect says how the residual it
 //! leaves looks (its feature maps), how to add it to a scene at its neutral
-//! value (so the extended scene renders as before) with its parameters
+//! value (so the extended scene renders as before; `near_light`'s lamp,
+//! far but not infinitely, to a level) with its parameters
 //! freed, where else its search may start, and which fitted parameters it
 //! trades with. Adding an effect: its module, and one line in [`ALL`].
 
