@@ -1,6 +1,7 @@
 //! The physically based backends against the built-in tracer and on their
 //! own: a diffuse-only scene renders the same everywhere (within 0.5 %),
-//! `scenefit fit --renderer R` recovers a target R rendered, and missing
+//! `scenefit fit --renderer R` recovers a target R rendered, a near light
+//! is drawn as its point light by every backend, and missing
 //! renderers or unsupported fields are a user's error (exit code 2).
 //! Renderers run for real; a missing one skips its test unless CI=true.
 
@@ -58,6 +59,39 @@ fn blender_agrees_with_phong() {
 fn mitsuba_agrees_with_phong() {
     if have_mitsuba() {
         assert!(agreement("mitsuba") <= 0.5);
+    }
+}
+
+/// The diffuse scene's key light written as a near light (a directional
+/// light with a distance, render/near_lights.rs) at the same place and with
+/// the same irradiance at the origin: `renderer` draws what it draws for the
+/// point light (deviation in percent).
+fn near_light_against_point_light(renderer: &str) -> f64 {
+    let point = diffuse_scene(16, 1);
+    let mut near = point.clone();
+    let d = 14f64.sqrt();
+    near["lights"][0] = serde_json::json!({"name": "key", "type": "directional",
+        "direction": [1.0 / d, 3.0 / d, 2.0 / d], "distance": d, "intensity": 10.0 / 14.0,
+        "color": [1, 1, 1]});
+    let r = from_spec(renderer).unwrap();
+    let a = render_one(r.as_ref(), &scene(&point), 7).unwrap_or_else(|e| panic!("{renderer}: {e}"));
+    let b = render_one(r.as_ref(), &scene(&near), 7).unwrap_or_else(|e| panic!("{renderer}: {e}"));
+    let dev = deviation(&a, &b, None).average;
+    eprintln!("{renderer}: near light against its point light {dev:.4} %");
+    dev
+}
+
+#[test]
+fn every_backend_draws_a_near_light_as_its_point_light() {
+    assert!(near_light_against_point_light("phong") <= 0.01);
+    if have("povray", "POV-Ray") {
+        assert!(near_light_against_point_light("povray") <= 0.01);
+    }
+    if have("blender", "Blender") {
+        assert!(near_light_against_point_light("blender") <= 0.01);
+    }
+    if have_mitsuba() {
+        assert!(near_light_against_point_light("mitsuba") <= 0.01);
     }
 }
 
