@@ -39,6 +39,18 @@ impl Features<'_> {
         blur(src, self.width, self.height, r)
     }
 
+    /// R·x, R·y, R·x², R·y²: a smooth multiplicative ramp over the image
+    /// (a light's irradiance changing across the scene).
+    pub fn ramp(&self) -> Vec<Vec<f64>> {
+        let (r, xs, ys) = (self.render, &self.xs, &self.ys);
+        vec![
+            self.map(|i| r[i] * xs[i]),
+            self.map(|i| r[i] * ys[i]),
+            self.map(|i| r[i] * xs[i] * xs[i]),
+            self.map(|i| r[i] * ys[i] * ys[i]),
+        ]
+    }
+
     /// The highlight excess S = max(0, R − blur R) and its blur over 2 and
     /// 5 px.
     pub fn highlight(&self) -> (Vec<f64>, Vec<f64>, Vec<f64>) {

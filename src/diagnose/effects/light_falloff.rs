@@ -19,13 +19,7 @@ impl Effect for LightFalloff {
 
     /// R·x, R·y, R·x², R·y² (a smooth multiplicative ramp).
     fn features(&self, f: &Features) -> Vec<Vec<f64>> {
-        let (r, xs, ys) = (f.render, &f.xs, &f.ys);
-        vec![
-            f.map(|i| r[i] * xs[i]),
-            f.map(|i| r[i] * ys[i]),
-            f.map(|i| r[i] * xs[i] * xs[i]),
-            f.map(|i| r[i] * ys[i] * ys[i]),
-        ]
+        f.ramp()
     }
 
     /// The first point light without an exponent gets one, at the value

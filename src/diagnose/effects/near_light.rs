@@ -4,7 +4,7 @@
 //! a `distance` (render/near_lights.rs), shared by every photograph of a
 //! set: a rig's lamps sit at about one distance from the object.
 
-use super::edit::{scalar, scale, Trades};
+use super::edit::{field_of, scalar, scale, Trades};
 use super::Effect;
 use crate::diagnose::residual::Features;
 use crate::scene::field::LightField;
@@ -27,16 +27,9 @@ impl Effect for NearLight {
         "near_light"
     }
 
-    /// R·x, R·y, R·x², R·y²: irradiance rising towards the light, a smooth
-    /// multiplicative ramp.
+    /// A smooth multiplicative ramp: irradiance rising towards the light.
     fn features(&self, f: &Features) -> Vec<Vec<f64>> {
-        let (r, xs, ys) = (f.render, &f.xs, &f.ys);
-        vec![
-            f.map(|i| r[i] * xs[i]),
-            f.map(|i| r[i] * ys[i]),
-            f.map(|i| r[i] * xs[i] * xs[i]),
-            f.map(|i| r[i] * ys[i] * ys[i]),
-        ]
+        f.ramp()
     }
 
     /// The first directional light without a distance gets one, far away.
@@ -63,10 +56,7 @@ impl Effect for NearLight {
     /// A fit without the distance has nothing it bent to fake it but the
     /// light's direction and level, so the starts only bring the light in.
     fn starts(&self, extended: &Scene, added: &[FreeParam]) -> Vec<Scene> {
-        let Some(field) = added
-            .first()
-            .and_then(|f| Field::resolve(extended, &f.param).ok())
-        else {
+        let Some(field) = added.first().and_then(|f| field_of(extended, f)) else {
             return Vec::new();
         };
         let size = scale(extended);
