@@ -37,7 +37,14 @@ fn bench(c: &mut Criterion) {
     let mut group = c.benchmark_group("phong_generation_of_80");
     group.throughput(Throughput::Elements(80));
     group.sample_size(30);
-    for file in ["sphere_floor.json", "paper_box.json"] {
+    // The last two: the same ball and photograph size, its centre fixed
+    // (hits traced once) and free (hits traced per candidate).
+    for file in [
+        "sphere_floor.json",
+        "paper_box.json",
+        "diligent_ball.json",
+        "diligent_ball/scene.json",
+    ] {
         let (mut session, scenes) = generation(file);
         group.bench_function(file, |b| b.iter(|| session.render_batch(&scenes, 0)));
     }

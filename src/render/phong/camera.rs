@@ -59,4 +59,24 @@ impl CameraRays {
             }
         }
     }
+
+    /// Where point `p` lands on the image, in pixels (the inverse of
+    /// [`CameraRays::ray`]); `None` when it is not in front of a pinhole.
+    pub fn pixel_of(&self, p: V3) -> Option<(f64, f64)> {
+        let q = p - self.origin;
+        let (sx, sy) = match self.kind {
+            CameraKind::Perspective => {
+                let z = q.dot(self.forward);
+                if z <= 1e-9 {
+                    return None;
+                }
+                (q.dot(self.right) / z, q.dot(self.up) / z)
+            }
+            CameraKind::Orthographic => (q.dot(self.right), q.dot(self.up)),
+        };
+        Some((
+            (sx / self.half_w + 1.0) * self.width / 2.0,
+            (1.0 - sy / self.half_h) * self.height / 2.0,
+        ))
+    }
 }

@@ -439,7 +439,11 @@ mod tests {
         let mut scene = crate::scene::load(std::path::Path::new(path)).unwrap();
         scene.image.width = 48;
         scene.image.height = 36;
-        let paths = Paths::build(&scene, &Variation::new(&scene, &ParamSpace::default()));
+        let paths = Paths::build(
+            &scene,
+            &Variation::new(&scene, &ParamSpace::default()),
+            true,
+        );
         let pk = Packed::new(&paths, scene.lights.len());
         // A light over the ball (its shadow on the floor), one low beside
         // it (a long shadow), and a sun; small and large disks.

@@ -2,8 +2,44 @@
 //! parallelograms (quads); a box is six quads. Every primitive remembers the
 //! scene object it belongs to.
 
+use super::camera::CameraRays;
 use crate::math::V3;
 use crate::scene::{Scene, ShapeKind};
+use std::ops::Range;
+
+/// An axis-aligned rectangle of image points, in pixels.
+#[derive(Clone, Copy, Debug)]
+pub struct Rect {
+    x0: f64,
+    x1: f64,
+    y0: f64,
+    y1: f64,
+}
+
+impl Rect {
+    const EMPTY: Rect = Rect {
+        x0: f64::INFINITY,
+        x1: f64::NEG_INFINITY,
+        y0: f64::INFINITY,
+        y1: f64::NEG_INFINITY,
+    };
+
+    /// Grown to hold (x, y), with a margin far above rounding error.
+    fn with(self, x: f64, y: f64) -> Rect {
+        const MARGIN: f64 = 1e-3;
+        Rect {
+            x0: self.x0.min(x - MARGIN),
+            x1: self.x1.max(x + MARGIN),
+            y0: self.y0.min(y - MARGIN),
+            y1: self.y1.max(y + MARGIN),
+        }
+    }
+
+    #[inline]
+    fn contains(&self, x: f64, y: f64) -> bool {
+        x >= self.x0 && x <= self.x1 && y >= self.y0 && y <= self.y1
+    }
+}
 
 /// Rays start this far off a surface so that they do not hit it again.
 pub const EPS: f64 = 1e-7;
@@ -107,9 +143,18 @@ impl Geometry {
 
     /// The nearest hit along the ray within (EPS, t_max).
     pub fn intersect(&self, o: V3, d: V3, t_max: f64) -> Option<Hit> {
+        self.nearest(o, d, t_max, |_| true)
+    }
+
+    /// The nearest hit within (EPS, t_max) among the primitives `tested` keeps.
+    #[inline(always)]
+    fn nearest(&self, o: V3, d: V3, t_max: f64, tested: impl Fn(usize) -> bool) -> Option<Hit> {
         let mut best: Option<Hit> = None;
         let mut t_best = t_max;
         for (i, prim) in self.prims.iter().enumerate() {
+            if !tested(i) {
+                continue;
+            }
             if let Some((t, n)) = prim.intersect(o, d, t_best) {
                 t_best = t;
                 best = Some(Hit {
@@ -120,6 +165,71 @@ impl Geometry {
             }
         }
         best
+    }
+
+    /// For each primitive, the pixel rectangle its image lies in, when one
+    /// can be bounded: a sphere by the corners of its bounding cube, a quad
+    /// by its own, all in front of the camera (a perspective projection
+    /// keeps a convex set inside the hull of its corners' images). `None`:
+    /// it may be seen anywhere (a plane, or a corner behind a pinhole).
+    pub fn screen_rects(&self, cam: &CameraRays) -> Vec<Option<Rect>> {
+        self.prims
+            .iter()
+            .map(|prim| {
+                let corners: Vec<V3> = match *prim {
+                    Prim::Sphere { c, r2 } => {
+                        let r = V3::new(1.0, 1.0, 1.0) * r2.sqrt();
+                        corners(c - r, c + r).to_vec()
+                    }
+                    Prim::Quad { o, u, v, .. } => vec![o, o + u, o + v, o + u + v],
+                    Prim::Plane { .. } => return None,
+                };
+                let mut rect = Rect::EMPTY;
+                for k in corners {
+                    let (x, y) = cam.pixel_of(k)?;
+                    rect = rect.with(x, y);
+                }
+                Some(rect)
+            })
+            .collect()
+    }
+
+    /// The pixels of the image rows [y0, y1) whose camera rays may hit
+    /// anything, from `rects` (all of them when some primitive is unbounded).
+    pub fn row_span(rects: &[Option<Rect>], y0: f64, y1: f64, width: u32) -> Range<u32> {
+        let mut lo = f64::INFINITY;
+        let mut hi = f64::NEG_INFINITY;
+        for rect in rects {
+            match rect {
+                None => return 0..width,
+                Some(r) if r.y1 >= y0 && r.y0 <= y1 => {
+                    lo = lo.min(r.x0);
+                    hi = hi.max(r.x1);
+                }
+                Some(_) => {}
+            }
+        }
+        if lo > hi {
+            return 0..0;
+        }
+        // Pixel x holds the image points [x, x + 1).
+        let first = (lo.floor() - 1.0).clamp(0.0, width as f64) as u32;
+        let end = (hi.ceil() + 1.0).clamp(0.0, width as f64) as u32;
+        first..end
+    }
+
+    /// The nearest hit along a camera ray through image point (x, y), among
+    /// the primitives `rects` does not rule out there.
+    pub fn intersect_camera_ray(
+        &self,
+        o: V3,
+        d: V3,
+        (x, y): (f64, f64),
+        rects: &[Option<Rect>],
+    ) -> Option<Hit> {
+        self.nearest(o, d, f64::INFINITY, |i| {
+            rects[i].is_none_or(|r| r.contains(x, y))
+        })
     }
 
     /// A possible occluder of point `p`, in the form fastest to test from there.

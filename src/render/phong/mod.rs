@@ -53,7 +53,9 @@ impl Renderer for Phong {
         let cached = if moves_geometry {
             None
         } else {
-            Some(Arc::new(pool.install(|| Prepared::new(base, &variation))))
+            Some(Arc::new(
+                pool.install(|| Prepared::new(base, &variation, true)),
+            ))
         };
         Ok(Box::new(PhongSession {
             pool,
@@ -70,8 +72,8 @@ struct Prepared {
 }
 
 impl Prepared {
-    fn new(scene: &Scene, variation: &Variation) -> Prepared {
-        let paths = Paths::build(scene, variation);
+    fn new(scene: &Scene, variation: &Variation, parallel: bool) -> Prepared {
+        let paths = Paths::build(scene, variation, parallel);
         let packed = Packed::new(&paths, scene.lights.len());
         Prepared { paths, packed }
     }
@@ -91,7 +93,7 @@ impl PhongSession {
         match &self.cached {
             Some(p) => shade::shade(&p.paths, &p.packed, scene, &maps, &mut buf),
             None => {
-                let p = Prepared::new(scene, &self.variation);
+                let p = Prepared::new(scene, &self.variation, false);
                 shade::shade(&p.paths, &p.packed, scene, &maps, &mut buf)
             }
         }

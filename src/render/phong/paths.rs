@@ -5,7 +5,7 @@
 //! free; built per candidate when a free parameter moves geometry.
 
 use super::camera::CameraRays;
-use super::geometry::{Geometry, Occluder, EPS};
+use super::geometry::{Geometry, Hit, Occluder, EPS};
 use crate::math::V3;
 use crate::scene::field::{LightField, MaterialField};
 use crate::scene::{Field, LightKind, ParamSpace, Scene};
@@ -116,48 +116,66 @@ impl Variation {
 }
 
 impl Paths {
-    /// Traces the camera rays of `scene` (rows in parallel).
-    pub fn build(scene: &Scene, var: &Variation) -> Paths {
+    /// Traces the camera rays of `scene`: rows in parallel when `parallel`
+    /// (the one build of a session), in one sequence otherwise (a build per
+    /// candidate, whose batch already fills the threads).
+    pub fn build(scene: &Scene, var: &Variation, parallel: bool) -> Paths {
         let geometry = Geometry::new(scene);
         let cam = CameraRays::new(&scene.camera, scene.image);
+        // Most camera rays of a small object miss it: test each primitive
+        // only inside the rectangle its image lies in.
+        let rects = geometry.screen_rects(&cam);
         let (w, h) = (scene.image.width, scene.image.height);
         let aa = scene.render.antialias.max(1);
-        let rows: Vec<(Vec<Vertex>, Vec<Shadow>, Vec<Occluder>)> = (0..h)
-            .into_par_iter()
-            .map(|y| {
-                let mut t = Tracer {
-                    scene,
-                    geometry: &geometry,
-                    var,
-                    verts: Vec::new(),
-                    shadow: Vec::new(),
-                    occluders: Vec::new(),
-                    budget: 0,
-                };
-                for x in 0..w {
+        let trace_rows = |rows: std::ops::Range<u32>| {
+            let mut t = Tracer {
+                scene,
+                geometry: &geometry,
+                var,
+                verts: Vec::new(),
+                shadow: Vec::new(),
+                occluders: Vec::new(),
+                budget: 0,
+            };
+            for y in rows {
+                for x in Geometry::row_span(&rects, y as f64, (y + 1) as f64, w) {
                     for sy in 0..aa {
                         for sx in 0..aa {
                             let fx = x as f64 + (sx as f64 + 0.5) / aa as f64;
                             let fy = y as f64 + (sy as f64 + 0.5) / aa as f64;
                             let (o, d) = cam.ray(fx, fy);
+                            let Some(hit) = geometry.intersect_camera_ray(o, d, (fx, fy), &rects)
+                            else {
+                                continue;
+                            };
                             t.budget = MAX_VERTICES_PER_RAY;
-                            t.trace(y * w + x, o, d, NO_PARENT, Via::Camera, 0);
+                            t.record(y * w + x, o, d, hit, NO_PARENT, Via::Camera, 0);
                         }
                     }
                 }
-                (t.verts, t.shadow, t.occluders)
-            })
-            .collect();
+            }
+            (t.verts, t.shadow, t.occluders)
+        };
+        let mut parts: Vec<(Vec<Vertex>, Vec<Shadow>, Vec<Occluder>)> = if parallel {
+            (0..h)
+                .into_par_iter()
+                .map(|y| trace_rows(y..y + 1))
+                .collect()
+        } else {
+            vec![trace_rows(0..h)]
+        };
+        let rest = parts.split_off(1.min(parts.len()));
+        let (verts, shadow, occluders) = parts.pop().unwrap_or_default();
         let mut paths = Paths {
             width: w,
             height: h,
             samples_per_pixel: aa * aa,
-            verts: Vec::new(),
-            shadow: Vec::new(),
-            occluders: Vec::new(),
+            verts,
+            shadow,
+            occluders,
             geometry,
         };
-        for (verts, shadow, occluders) in rows {
+        for (verts, shadow, occluders) in rest {
             let base_v = paths.verts.len() as u32;
             let base_o = paths.occluders.len() as u32;
             paths.verts.extend(verts.into_iter().map(|mut v| {
@@ -198,9 +216,14 @@ const MAX_VERTICES_PER_RAY: u32 = 256;
 
 impl Tracer<'_> {
     fn trace(&mut self, pixel: u32, o: V3, d: V3, parent: u32, via: Via, depth: u32) {
-        let Some(hit) = self.geometry.intersect(o, d, f64::INFINITY) else {
-            return;
-        };
+        if let Some(hit) = self.geometry.intersect(o, d, f64::INFINITY) {
+            self.record(pixel, o, d, hit, parent, via, depth);
+        }
+    }
+
+    /// Keeps `hit` of the ray from `o` along `d`, and traces the rays it spawns.
+    #[allow(clippy::too_many_arguments)]
+    fn record(&mut self, pixel: u32, o: V3, d: V3, hit: Hit, parent: u32, via: Via, depth: u32) {
         let p = o + d * hit.t;
         let entering = hit.n.dot(d) < 0.0;
         let n = if entering { hit.n } else { -hit.n };
@@ -313,7 +336,7 @@ mod tests {
         let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/paper_box.json");
         let scene = crate::scene::load(&path).unwrap();
         let space = ParamSpace::from_scene(&scene);
-        let paths = Paths::build(&scene, &Variation::new(&scene, &space));
+        let paths = Paths::build(&scene, &Variation::new(&scene, &space), true);
         let mut tested = 0;
         for s in &paths.shadow {
             if let Shadow::Test { len, .. } = s {
@@ -325,5 +348,76 @@ mod tests {
             tested > paths.verts.len() / 2,
             "the sphere can shadow much of the box: {tested}"
         );
+    }
+
+    fn example(file: &str) -> Scene {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("scenes")
+            .join(file);
+        crate::scene::load(&path).unwrap()
+    }
+
+    /// Testing each primitive only inside its image's rectangle finds the
+    /// same first hit for every camera ray as testing them all: spheres,
+    /// a floor plane, a box's quads, perspective and orthographic cameras,
+    /// and a sphere the pinhole sits beside (its bounding cube partly
+    /// behind the camera, so it is never ruled out).
+    #[test]
+    fn culled_camera_rays_hit_what_every_primitive_would() {
+        let mut beside = example("sphere_floor.json");
+        let cam = V3::from(beside.camera.position);
+        let c = cam + V3::new(0.6, 0.0, 0.0);
+        beside.objects[0].shape.center = Some([c.x, c.y, c.z]);
+        for scene in [
+            example("sphere_floor.json"),
+            example("paper_box.json"),
+            example("diligent_ball.json"),
+            beside,
+        ] {
+            let geometry = Geometry::new(&scene);
+            let cam = CameraRays::new(&scene.camera, scene.image);
+            let rects = geometry.screen_rects(&cam);
+            let (w, h) = (scene.image.width, scene.image.height);
+            let mut hits = 0;
+            for y in 0..h {
+                let span = Geometry::row_span(&rects, y as f64, (y + 1) as f64, w);
+                for x in 0..w {
+                    let at = (x as f64 + 0.5, y as f64 + 0.5);
+                    let (o, d) = cam.ray(at.0, at.1);
+                    let all = geometry.intersect(o, d, f64::INFINITY);
+                    let culled = geometry.intersect_camera_ray(o, d, at, &rects);
+                    assert_eq!(
+                        all.map(|h| (h.t, h.object)),
+                        culled.map(|h| (h.t, h.object))
+                    );
+                    assert!(
+                        all.is_none() || span.contains(&x),
+                        "pixel ({x}, {y}) outside its row's span"
+                    );
+                    hits += all.is_some() as usize;
+                }
+            }
+            assert!(hits > 0);
+        }
+    }
+
+    /// The sequential build (one per candidate) and the parallel one (once
+    /// per session) hold the same hits in the same order.
+    #[test]
+    fn sequential_and_parallel_builds_agree() {
+        let scene = example("paper_box.json");
+        let var = Variation::new(&scene, &ParamSpace::from_scene(&scene));
+        let (a, b) = (
+            Paths::build(&scene, &var, true),
+            Paths::build(&scene, &var, false),
+        );
+        assert_eq!(a.verts.len(), b.verts.len());
+        for (u, v) in a.verts.iter().zip(&b.verts) {
+            assert_eq!(
+                (u.pixel, u.object, u.parent, u.p.x, u.n.y),
+                (v.pixel, v.object, v.parent, v.p.x, v.n.y)
+            );
+        }
+        assert_eq!(a.shadow, b.shadow);
     }
 }
