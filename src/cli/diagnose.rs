@@ -38,6 +38,11 @@ pub struct DiagnoseArgs {
     max_effects: usize,
     #[arg(long, default_value_t = 1)]
     seed: u64,
+    /// Refit the shared free parameters that move geometry (object shapes,
+    /// the camera's placement) as well; by default they are held where the
+    /// fit put them, which saves re-tracing every camera ray.
+    #[arg(long)]
+    refit_geometry: bool,
     /// Renders at once (default: the number of cores).
     #[arg(long)]
     jobs: Option<usize>,
@@ -69,6 +74,7 @@ pub fn run(a: DiagnoseArgs) -> Result<()> {
         max_rounds: a.max_effects,
         restart_generations: a.restart_generations,
         seed: a.seed,
+        refit_geometry: a.refit_geometry,
         ..DiagnoseConfig::default()
     };
     if let Some(j) = a.jobs {

@@ -40,6 +40,9 @@ pub struct DiagnoseConfig {
     pub jobs: usize,
     /// How renderer processes run (timeouts, worker restarts, Python).
     pub render_options: crate::render::RenderOptions,
+    /// Refit the shared free entries that move geometry too, instead of
+    /// holding them where the fit put them (`held.rs`).
+    pub refit_geometry: bool,
 }
 
 impl Default for DiagnoseConfig {
@@ -63,6 +66,7 @@ impl Default for DiagnoseConfig {
                 .map(|n| n.get())
                 .unwrap_or(1),
             render_options: Default::default(),
+            refit_geometry: false,
         }
     }
 }

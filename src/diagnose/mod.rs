@@ -21,6 +21,7 @@
 mod albedo;
 mod config;
 pub mod effects;
+mod held;
 mod inputs;
 mod lanes;
 pub mod output;
@@ -116,6 +117,10 @@ pub struct Diagnosis {
     pub unexplained: bool,
     pub renders: usize,
     pub wall_seconds: f64,
+    /// Free entries held at the fit's values through the diagnosis
+    /// (shared geometry, `held.rs`); free again in improved_scene.json.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub held: Vec<String>,
 }
 
 /// The name `accepted` gets when smooth structure remains.
@@ -127,11 +132,16 @@ pub fn run(inputs: &Inputs, out: &Path, config: &DiagnoseConfig) -> Result<Diagn
     std::fs::create_dir_all(out).map_err(|e| Error::io(out, e))?;
     let renderer = from_spec_with(&config.renderer, &config.render_options)?;
     let (target, mask) = (&inputs.target, inputs.mask.as_ref());
-    let image0 = render_one(renderer.as_ref(), &inputs.scene, 0)?;
+    let mut scene = inputs.scene.clone();
+    let held = match config.refit_geometry {
+        true => Vec::new(),
+        false => held::hold_geometry(&mut scene),
+    };
+    let image0 = render_one(renderer.as_ref(), &scene, 0)?;
     let before = deviation(target, &image0, mask);
     let residual_before = Residual::new(target, &image0, mask);
     let mut fits = Refits::new(renderer.as_ref(), inputs, config);
-    let mut model = fits.unchanged(Model::new(inputs.scene.clone(), image0, inputs))?;
+    let mut model = fits.unchanged(Model::new(scene, image0, inputs))?;
     let refined = deviation(target, &model.image, mask);
 
     let mut candidates = Vec::new();
@@ -155,21 +165,23 @@ pub fn run(inputs: &Inputs, out: &Path, config: &DiagnoseConfig) -> Result<Diagn
     if unexplained {
         accepted.push(UNEXPLAINED.into());
     }
+    let improved = held::restore(&model.scene, &held);
     let diagnosis = Diagnosis {
         deviation_before: before,
         deviation_after: deviation(target, &model.image, mask),
         candidates,
         accepted,
-        params_after: ParamSpace::from_scene(&model.scene).json_values(&model.scene),
+        params_after: ParamSpace::from_scene(&improved).json_values(&improved),
         deviation_refined: refined,
         unexplained,
         // The refits, and the first render of the fitted model.
         renders: fits.renders + 1,
         wall_seconds: started.elapsed().as_secs_f64(),
+        held: held::paths(&held),
     };
     albedo::prune(out, &model.scene);
     let residuals = (&residual_before, &residual_after);
-    report::write(out, &diagnosis, &model.scene, &model.image, residuals)?;
+    report::write(out, &diagnosis, &improved, &model.image, residuals)?;
     Ok(diagnosis)
 }
 

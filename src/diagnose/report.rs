@@ -129,6 +129,12 @@ fn summary(page: &mut Page, d: &Diagnosis) {
     };
     let tail = format!(". {} renders in {:.1} s.", d.renders, d.wall_seconds);
     page.p_bold("Accepted: ", &acc, &tail);
+    if !d.held.is_empty() {
+        page.p(&format!(
+            "Held where the fit put them (geometry): {}.",
+            d.held.join(", ")
+        ));
+    }
     page.h2("Deviation per channel (%)", "deviation");
     page.table(
         &["", "r", "g", "b", "average"],
@@ -223,6 +229,7 @@ mod tests {
             unexplained: false,
             renders: 1234,
             wall_seconds: 5.0,
+            held: Vec::new(),
         };
         let page = html(&d, 0.05);
         for part in [

@@ -412,9 +412,14 @@ fn score(
         .collect())
 }
 
-/// The renders of the fitted model as it stands.
-fn initial(renderer: &dyn Renderer, inputs: &SetInputs, jobs: usize) -> Result<SetModel> {
-    let shots = shots_of(&inputs.scene, inputs, &inputs.own)?;
+/// The renders of the fitted model `scene` as it stands.
+fn initial(
+    renderer: &dyn Renderer,
+    inputs: &SetInputs,
+    scene: Scene,
+    jobs: usize,
+) -> Result<SetModel> {
+    let shots = shots_of(&scene, inputs, &inputs.own)?;
     let mut images = Vec::with_capacity(shots.len());
     let mut total = 0.0;
     for (r, s) in score(renderer, &shots, jobs)?.into_iter().zip(&shots) {
@@ -429,7 +434,7 @@ fn initial(renderer: &dyn Renderer, inputs: &SetInputs, jobs: usize) -> Result<S
         images.push(img);
     }
     Ok(SetModel {
-        scene: inputs.scene.clone(),
+        scene,
         own: inputs.own.clone(),
         images,
         sad: total,
@@ -451,7 +456,12 @@ pub fn run(inputs: &SetInputs, out: &Path, config: &DiagnoseConfig) -> Result<Se
     let started = Instant::now();
     std::fs::create_dir_all(out).map_err(|e| Error::io(out, e))?;
     let renderer = from_spec_with(&config.renderer, &config.render_options)?;
-    let model0 = initial(renderer.as_ref(), inputs, config.jobs)?;
+    let mut scene = inputs.scene.clone();
+    let held = match config.refit_geometry {
+        true => Vec::new(),
+        false => super::held::hold_geometry(&mut scene),
+    };
+    let model0 = initial(renderer.as_ref(), inputs, scene, config.jobs)?;
     let before = model0.deviations(inputs);
     let residuals_before = model0.residuals(inputs);
     let mut fits = SetRefits {
@@ -478,6 +488,7 @@ pub fn run(inputs: &SetInputs, out: &Path, config: &DiagnoseConfig) -> Result<Se
         accepted.push(UNEXPLAINED.into());
     }
     let after = model.deviations(inputs);
+    model.scene = super::held::restore(&model.scene, &held);
     let space = ParamSpace::from_scene(&model.scene);
     let diagnosis = Diagnosis {
         deviation_before: pooled(&before, inputs),
@@ -489,6 +500,7 @@ pub fn run(inputs: &SetInputs, out: &Path, config: &DiagnoseConfig) -> Result<Se
         unexplained,
         renders: fits.renders,
         wall_seconds: started.elapsed().as_secs_f64(),
+        held: super::held::paths(&held),
     };
     let shots_after = inputs
         .shots
