@@ -2,8 +2,8 @@
 rough-plastic ball (GGX, not the tracer's Phong) rendered by Mitsuba 3
 under N directional lights, through a camera of its own (a gain, a power
 law, photon noise, 8-bit PNG). Writes OUT/000.png..., mask.png, scene.json
-(the DiLiGenT ball's scene: each light's direction and intensity free per
-photograph), shots.json and lights.txt (the true directions, one per line,
+(the DiLiGenT ball's set scene: each light's direction and intensity free
+per photograph, the material and the ball's centre shared), shots.json and lights.txt (the true directions, one per line,
 towards the light).
 
     python3 scripts/mitsuba-set.py OUT [SEED]

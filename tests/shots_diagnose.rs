@@ -6,7 +6,7 @@
 //! set is the planted one (each photograph's own light colour among them, an
 //! effect only a set shows), the deviation falls to at most half of what it
 //! was for every effect and to at most 30 % for all but one (measured: 11
-//! of 12; area_light ends at 0.32, docs/results.md); a set with noise only
+//! of 12; area_light ends at 0.39, docs/results.md); a set with noise only
 //! accepts nothing.
 
 mod effects_data;
