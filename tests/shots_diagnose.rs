@@ -4,10 +4,9 @@
 //! in tests/diagnose.rs).
 //! For every effect the diagnosis knows, the first effect accepted on the
 //! set is the planted one (each photograph's own light colour among them, an
-//! effect only a set shows), the deviation falls to at most half of what it
-//! was for every effect and to at most 30 % for all but one (measured: 11
-//! of 12; area_light ends at 0.39, docs/results.md); a set with noise only
-//! accepts nothing.
+//! effect only a set shows), the deviation falls to at most 30 % of what
+//! it was for every effect (measured: 12 of 12, the worst fresnel at 0.13,
+//! docs/results.md); a set with noise only accepts nothing.
 
 mod effects_data;
 
@@ -154,7 +153,7 @@ fn every_effect_planted_in_a_set_is_the_first_accepted_on_it() {
             after / before,
             t.elapsed().as_secs_f64()
         ));
-        if got != *effect || after > 0.5 * before {
+        if got != *effect {
             wrong.push(effect.to_string());
         }
         if after > 0.3 * before {
@@ -164,7 +163,7 @@ fn every_effect_planted_in_a_set_is_the_first_accepted_on_it() {
     println!("{}", lines.join("\n"));
     assert!(wrong.is_empty(), "wrong: {wrong:?}\n{}", lines.join("\n"));
     assert!(
-        above_30.len() <= 1,
+        above_30.is_empty(),
         "after > 30 % of before: {above_30:?}\n{}",
         lines.join("\n")
     );

@@ -481,6 +481,13 @@ pub fn run(inputs: &SetInputs, out: &Path, config: &DiagnoseConfig) -> Result<Se
         .map(|s| samples(&s.target.image, s.target.mask.as_ref()))
         .sum();
     let (candidates, mut accepted) = rounds(&mut fits, &mut model, n)?;
+    if !accepted.is_empty() {
+        // The last refit stopped where block descent slows: along a valley
+        // where shared and per-shot values trade. A warm refit from there
+        // goes on down it.
+        let polished = fits.run(&model.scene, &model.own)?;
+        model = model.better(polished);
+    }
     let residuals_after = model.residuals(inputs);
     let structured = residuals_after.iter().filter(|r| r.structured()).count();
     let unexplained = 2 * structured > residuals_after.len();
