@@ -22,6 +22,17 @@ pub fn hold_geometry(scene: &mut Scene) -> Vec<FreeParam> {
     held
 }
 
+/// `scene` as the diagnosis refits it, and the entries held out of it
+/// (none when `refit_geometry`).
+pub fn split(scene: &Scene, refit_geometry: bool) -> (Scene, Vec<FreeParam>) {
+    let mut scene = scene.clone();
+    let held = match refit_geometry {
+        true => Vec::new(),
+        false => hold_geometry(&mut scene),
+    };
+    (scene, held)
+}
+
 /// `scene` with the held entries free again (at its values).
 pub fn restore(scene: &Scene, held: &[FreeParam]) -> Scene {
     let mut out = scene.clone();

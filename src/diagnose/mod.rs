@@ -132,11 +132,7 @@ pub fn run(inputs: &Inputs, out: &Path, config: &DiagnoseConfig) -> Result<Diagn
     std::fs::create_dir_all(out).map_err(|e| Error::io(out, e))?;
     let renderer = from_spec_with(&config.renderer, &config.render_options)?;
     let (target, mask) = (&inputs.target, inputs.mask.as_ref());
-    let mut scene = inputs.scene.clone();
-    let held = match config.refit_geometry {
-        true => Vec::new(),
-        false => held::hold_geometry(&mut scene),
-    };
+    let (scene, held) = held::split(&inputs.scene, config.refit_geometry);
     let image0 = render_one(renderer.as_ref(), &scene, 0)?;
     let before = deviation(target, &image0, mask);
     let residual_before = Residual::new(target, &image0, mask);

@@ -456,11 +456,7 @@ pub fn run(inputs: &SetInputs, out: &Path, config: &DiagnoseConfig) -> Result<Se
     let started = Instant::now();
     std::fs::create_dir_all(out).map_err(|e| Error::io(out, e))?;
     let renderer = from_spec_with(&config.renderer, &config.render_options)?;
-    let mut scene = inputs.scene.clone();
-    let held = match config.refit_geometry {
-        true => Vec::new(),
-        false => super::held::hold_geometry(&mut scene),
-    };
+    let (scene, held) = super::held::split(&inputs.scene, config.refit_geometry);
     let model0 = initial(renderer.as_ref(), inputs, scene, config.jobs)?;
     let before = model0.deviations(inputs);
     let residuals_before = model0.residuals(inputs);
@@ -509,20 +505,9 @@ pub fn run(inputs: &SetInputs, out: &Path, config: &DiagnoseConfig) -> Result<Se
         wall_seconds: started.elapsed().as_secs_f64(),
         held: super::held::paths(&held),
     };
-    let shots_after = inputs
-        .shots
-        .iter()
-        .enumerate()
-        .map(|(i, s)| ShotAfter {
-            name: s.name.clone(),
-            params: model.own[i].clone(),
-            deviation_before: before[i],
-            deviation_after: after[i],
-        })
-        .collect();
     let d = SetDiagnosis {
         diagnosis,
-        shots_after,
+        shots_after: shots_after(inputs, &model, &before, &after),
     };
     super::albedo::prune(out, &model.scene);
     super::report::write_set(
@@ -533,6 +518,26 @@ pub fn run(inputs: &SetInputs, out: &Path, config: &DiagnoseConfig) -> Result<Se
         (&residuals_before, &residuals_after),
     )?;
     Ok(d)
+}
+
+/// Every photograph's own values after, and its deviations.
+fn shots_after(
+    inputs: &SetInputs,
+    model: &SetModel,
+    before: &[Deviation],
+    after: &[Deviation],
+) -> Vec<ShotAfter> {
+    inputs
+        .shots
+        .iter()
+        .enumerate()
+        .map(|(i, s)| ShotAfter {
+            name: s.name.clone(),
+            params: model.own[i].clone(),
+            deviation_before: before[i],
+            deviation_after: after[i],
+        })
+        .collect()
 }
 
 /// The rounds: every effect not yet accepted tried on the set, the
