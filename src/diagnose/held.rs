@@ -12,7 +12,7 @@ use crate::scene::{Field, FreeParam, Scene};
 
 /// Takes the shared free entries of `scene` that move geometry out of its
 /// free list, and returns them.
-pub fn hold_geometry(scene: &mut Scene) -> Vec<FreeParam> {
+fn hold_geometry(scene: &mut Scene) -> Vec<FreeParam> {
     let moves = |f: &FreeParam| {
         !f.per_shot && Field::resolve(scene, &f.param).is_ok_and(|field| field.moves_geometry())
     };

@@ -156,7 +156,7 @@ impl Paths {
             }
             (t.verts, t.shadow, t.occluders)
         };
-        let mut parts: Vec<(Vec<Vertex>, Vec<Shadow>, Vec<Occluder>)> = if parallel {
+        let parts: Vec<(Vec<Vertex>, Vec<Shadow>, Vec<Occluder>)> = if parallel {
             (0..h)
                 .into_par_iter()
                 .map(|y| trace_rows(y..y + 1))
@@ -164,8 +164,9 @@ impl Paths {
         } else {
             vec![trace_rows(0..h)]
         };
-        let rest = parts.split_off(1.min(parts.len()));
-        let (verts, shadow, occluders) = parts.pop().unwrap_or_default();
+        // The first part is taken as it is; the others are appended to it.
+        let mut parts = parts.into_iter();
+        let (verts, shadow, occluders) = parts.next().unwrap_or_default();
         let mut paths = Paths {
             width: w,
             height: h,
@@ -175,7 +176,7 @@ impl Paths {
             occluders,
             geometry,
         };
-        for (verts, shadow, occluders) in rest {
+        for (verts, shadow, occluders) in parts {
             let base_v = paths.verts.len() as u32;
             let base_o = paths.occluders.len() as u32;
             paths.verts.extend(verts.into_iter().map(|mut v| {
