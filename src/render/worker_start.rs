@@ -12,7 +12,13 @@ use std::time::Duration;
 
 /// The modules every Python worker imports, written beside it: the
 /// JSON-lines protocol and the shared scene translation.
-const MODULES: &[(&str, &str)] = &[("jsonlines.py", include_str!("../../workers/jsonlines.py"))];
+const MODULES: &[(&str, &str)] = &[
+    ("jsonlines.py", include_str!("../../workers/jsonlines.py")),
+    (
+        "scene_common.py",
+        include_str!("../../workers/scene_common.py"),
+    ),
+];
 
 /// A persistent Python worker as a backend ships it.
 pub struct PythonWorker {
