@@ -104,13 +104,14 @@ import time
 import traceback
 
 # Blender does not put a -P script's folder on sys.path: the protocol module
-# sits beside this script (as scenefit writes it) or in the repository's
-# workers/ folder.
+# and the shared scene reader (scene_common) sit beside this script (as
+# scenefit writes them) or in the repository's workers/ folder.
 _HERE = os.path.dirname(os.path.abspath(__file__))
 for _dir in (os.path.join(_HERE, "..", "workers"), _HERE):
     if _dir not in sys.path:
         sys.path.insert(0, _dir)
 import jsonlines  # noqa: E402
+from scene_common import SceneError, describe, roughness  # noqa: E402
 
 TIMING = bool(os.environ.get("SCENEFIT_WORKER_TIMING"))
 
@@ -167,51 +168,10 @@ SPHERE_RINGS = SPHERE_SEGMENTS // 2
 PLANE_HALF = 1000.0  # the "infinite" plane is a 2 km quad
 
 
-class SceneError(jsonlines.RequestError):
-    """A scene this worker cannot build (answered as ok:false)."""
-
-
 # ---------------------------------------------------------------------------
-# scene JSON helpers
+# Blender values (the scene is read by scene_common.describe, shared with the
+# Mitsuba worker)
 # ---------------------------------------------------------------------------
-
-
-def _num(d, key, where, default=None):
-    if key not in d:
-        if default is None:
-            raise SceneError("missing '%s' in %s" % (key, where))
-        return float(default)
-    v = d[key]
-    if isinstance(v, bool) or not isinstance(v, (int, float)):
-        raise SceneError("'%s' in %s must be a number, got %r" % (key, where, v))
-    if not math.isfinite(v):
-        raise SceneError("'%s' in %s is not finite" % (key, where))
-    return float(v)
-
-
-def _vec3(d, key, where, default=None):
-    if key not in d:
-        if default is None:
-            raise SceneError("missing '%s' in %s" % (key, where))
-        return tuple(float(x) for x in default)
-    v = d[key]
-    if (not isinstance(v, list) or len(v) != 3
-            or any(isinstance(x, bool) or not isinstance(x, (int, float)) for x in v)):
-        raise SceneError("'%s' in %s must be a list of 3 numbers, got %r" % (key, where, v))
-    if not all(math.isfinite(x) for x in v):
-        raise SceneError("'%s' in %s is not finite" % (key, where))
-    return tuple(float(x) for x in v)
-
-
-def _obj(d, key, where, required=True):
-    if key not in d:
-        if required:
-            raise SceneError("missing '%s' in %s" % (key, where))
-        return {}
-    v = d[key]
-    if not isinstance(v, dict):
-        raise SceneError("'%s' in %s must be an object" % (key, where))
-    return v
 
 
 def _f32(x):
@@ -252,66 +212,18 @@ def fresh_nodes(owner, output_type):
     return nt, nt.nodes.new(output_type)
 
 
-def material_kind(m, where="material"):
-    """lambertian (diffuse only), phong (the built-in tracer's lobes, own
-    node graph) or principled (transmission: glass)."""
-    spec = _num(m, "specular", where, 0.0)
-    spec2 = _num(m, "specular2", where, 0.0)
-    refl = _num(m, "reflection", where, 0.0)
-    trans = _num(m, "transmission", where, 0.0)
-    if trans != 0.0:
-        return "principled"
-    if spec == 0.0 and spec2 == 0.0 and refl == 0.0:
-        return "lambertian"
-    return "phong"
-
-
 def falloff_kind(light):
     """inverse_square (Cycles' own), or custom: 1/d^p through a node tree."""
-    if light.get("type") != "point":
+    if light["type"] != "point" or light["power"] == 2.0:
         return "inverse_square"
-    p = light.get("falloff_power")
-    if p is None:
-        p = 0.0 if light.get("falloff", "inverse_square") == "none" else 2.0
-    return "inverse_square" if p == 2.0 else "custom"
+    return "custom"
 
 
-def falloff_power(light, where):
-    if "falloff_power" in light:
-        return _num(light, "falloff_power", where)
-    return 0.0 if light.get("falloff", "inverse_square") == "none" else 2.0
-
-
-def structure_of(scene):
-    """The part of a scene that decides which datablocks exist."""
-    if not isinstance(scene, dict):
-        raise SceneError("'scene' must be an object")
-    cam = _obj(scene, "camera", "scene")
-    lights = scene.get("lights", [])
-    objects = scene.get("objects", [])
-    if not isinstance(lights, list):
-        raise SceneError("'lights' must be a list")
-    if not isinstance(objects, list):
-        raise SceneError("'objects' must be a list")
-    ls = []
-    for i, l in enumerate(lights):
-        where = "lights[%d]" % i
-        if not isinstance(l, dict):
-            raise SceneError("%s must be an object" % where)
-        falloff = l.get("falloff", "inverse_square")
-        if falloff not in ("inverse_square", "none"):
-            raise SceneError("%s: falloff must be 'inverse_square' or 'none', got %r" % (where, falloff))
-        ls.append((str(l.get("name", "light%d" % i)), l.get("type"), falloff_kind(l)))
-    os_ = []
-    for i, o in enumerate(objects):
-        where = "objects[%d]" % i
-        if not isinstance(o, dict):
-            raise SceneError("%s must be an object" % where)
-        shape = _obj(o, "shape", where)
-        mat = _obj(o, "material", where, required=False)
-        os_.append((str(o.get("name", "object%d" % i)), shape.get("type"),
-                    material_kind(mat, "object '%s' material" % o.get("name", i))))
-    return (cam.get("type"), tuple(ls), tuple(os_))
+def structure_of(desc):
+    """The part of a described scene that decides which datablocks exist."""
+    return (desc["camera"]["type"],
+            tuple((L["name"], L["type"], falloff_kind(L)) for L in desc["lights"]),
+            tuple((o["name"], o["shape"]["type"], o["material"]["kind"]) for o in desc["objects"]))
 
 
 # ---------------------------------------------------------------------------
@@ -483,7 +395,7 @@ class Worker:
         self.lights = []
         self.objects = []
 
-    def build(self, scene, structure):
+    def build(self, structure):
         self.clear()
         coll = self.scene.collection
         cam_type, light_structs, obj_structs = structure
@@ -664,39 +576,40 @@ class Worker:
                       "lobes": lobes, "mirror": mirror})
 
     # -- values -------------------------------------------------------------
-    def apply(self, scene):
+    def apply(self, desc):
+        """Sets every value of the described scene (scene_common.describe)."""
         s = self.scene
         r = s.render
-        img = _obj(scene, "image", "scene")
-        w = int(_num(img, "width", "image"))
-        h = int(_num(img, "height", "image"))
-        if w < 1 or h < 1 or w > 65536 or h > 65536:
-            raise SceneError("image size %dx%d out of range" % (w, h))
-        if r.resolution_x != w:
-            r.resolution_x = w
-        if r.resolution_y != h:
-            r.resolution_y = h
-
-        rd = _obj(scene, "render", "scene", required=False)
-        samples = int(_num(rd, "samples", "render", 16))
-        if samples < 1:
-            raise SceneError("render.samples must be >= 1")
-        indirect = rd.get("indirect", True)
-        if not isinstance(indirect, bool):
-            raise SceneError("render.indirect must be true or false")
+        if r.resolution_x != desc["width"]:
+            r.resolution_x = desc["width"]
+        if r.resolution_y != desc["height"]:
+            r.resolution_y = desc["height"]
         c = s.cycles
-        nb = 8 if indirect else 0
-        for attr, val in (("samples", samples), ("max_bounces", nb), ("diffuse_bounces", nb),
+        nb = 8 if desc["indirect"] else 0
+        for attr, val in (("samples", desc["samples"]), ("max_bounces", nb), ("diffuse_bounces", nb),
                           ("glossy_bounces", nb), ("transmission_bounces", nb),
                           ("transparent_max_bounces", nb), ("volume_bounces", 0)):
             if getattr(c, attr) != val:
                 setattr(c, attr, val)
+        self._apply_camera(desc["camera"])
 
-        # camera
-        cam = _obj(scene, "camera", "scene")
-        pos = B(_vec3(cam, "position", "camera"))
-        look = B(_vec3(cam, "look_at", "camera"))
-        up = B(_vec3(cam, "up", "camera", (0, 1, 0)))
+        # ambient
+        amb = desc["ambient"]
+        _set(self.world_bg.inputs["Color"], "default_value", (amb[0], amb[1], amb[2], 1.0))
+        want = "MANUAL" if any(a != 0.0 for a in amb) else "NONE"
+        if self.world.cycles.sampling_method != want:
+            self.world.cycles.sampling_method = want
+
+        for (lo, fnode), L in zip(self.lights, desc["lights"]):
+            self._apply_light(lo, fnode, L)
+        for ent, o in zip(self.objects, desc["objects"]):
+            self._apply_shape(ent, o["shape"], "object '%s'" % o["name"])
+            self._apply_material(ent, o["material"], desc["lights"])
+
+    def _apply_camera(self, cam):
+        pos = B(cam["position"])
+        look = B(cam["look_at"])
+        up = B(cam["up"])
         f = look - pos
         if f.length < 1e-12:
             raise SceneError("camera.position equals camera.look_at")
@@ -713,148 +626,93 @@ class Worker:
             self.cam_key = (tuple(pos), tuple(look), tuple(up))
         cd = self.cam_obj.data
         if cd.type == "PERSP":
-            fov = _num(cam, "fov_y_deg", "camera")
-            if not (0.0 < fov < 180.0):
-                raise SceneError("camera.fov_y_deg must be in (0, 180)")
+            fov = cam["fov_y"]
             if abs(cd.angle_y - math.radians(fov)) > 1e-7 * math.radians(fov):
                 cd.angle_y = math.radians(fov)
         else:
-            height = _num(cam, "height", "camera")
-            if height <= 0:
-                raise SceneError("camera.height must be > 0")
-            _set(cd, "ortho_scale", height)
+            _set(cd, "ortho_scale", cam["height"])
 
-        # ambient
-        amb = _vec3(scene, "ambient", "scene", (0, 0, 0))
-        _set(self.world_bg.inputs["Color"], "default_value", (amb[0], amb[1], amb[2], 1.0))
-        want = "MANUAL" if any(a != 0.0 for a in amb) else "NONE"
-        if self.world.cycles.sampling_method != want:
-            self.world.cycles.sampling_method = want
+    def _apply_light(self, lo, fnode, L):
+        ld = lo.data
+        _set(ld, "color", L["color"])
+        if ld.type == "POINT":
+            _set(lo, "location", B(L["position"]))
+            _set(ld, "energy", 4.0 * math.pi * L["intensity"])
+            _set(ld, "shadow_soft_size", L["radius"])
+            if fnode is not None:
+                _set(fnode.inputs[1], "default_value", 2.0 - L["power"])
+        else:
+            d = B(L["direction"])
+            _set(lo, "rotation_quaternion", _rot_z_to(d, "light '%s'" % L["name"]))
+            _set(ld, "energy", L["intensity"])
+            # the sun's angle is its angular diameter
+            _set(ld, "angle", 2.0 * L["radius"])
 
-        # lights
-        for (lo, fnode), l in zip(self.lights, scene.get("lights", [])):
-            name = l.get("name", "?")
-            where = "light '%s'" % name
-            ld = lo.data
-            col = _vec3(l, "color", where, (1, 1, 1))
-            inten = _num(l, "intensity", where)
-            if inten < 0:
-                raise SceneError("%s: intensity must be >= 0" % where)
-            _set(ld, "color", col)
-            if ld.type == "POINT":
-                _set(lo, "location", B(_vec3(l, "position", where)))
-                _set(ld, "energy", 4.0 * math.pi * inten)
-                rad = _num(l, "radius", where, 0.0)
-                if rad < 0:
-                    raise SceneError("%s: radius must be >= 0" % where)
-                _set(ld, "shadow_soft_size", rad)
-                if fnode is not None:
-                    _set(fnode.inputs[1], "default_value", 2.0 - falloff_power(l, where))
-            else:
-                d = B(_vec3(l, "direction", where))
-                _set(lo, "rotation_quaternion", _rot_z_to(d, where))
-                _set(ld, "energy", inten)
-                rad = _num(l, "radius", where, 0.0)
-                if not 0.0 <= rad < math.pi / 2:
-                    raise SceneError("%s: radius must be in [0, pi/2)" % where)
-                # the sun's angle is its angular diameter
-                _set(ld, "angle", 2.0 * rad)
+    def _apply_shape(self, ent, sh, where):
+        ob = ent["obj"]
+        st = ent["shape"]
+        if st == "sphere":
+            rad = sh["radius"]
+            _set(ob, "location", B(sh["center"]))
+            _set(ob, "scale", (rad, rad, rad))
+        elif st == "plane":
+            _set(ob, "location", B(sh["point"]))
+            _set(ob, "rotation_quaternion", _rot_z_to(B(sh["normal"]), where))
+        elif st == "box":
+            lo_, hi = sh["min"], sh["max"]
+            _set(ob, "location", (lo_[0], -hi[2], lo_[1]))
+            # a near-zero extent would make a singular matrix; keep it tiny instead
+            _set(ob, "scale", (max(hi[0] - lo_[0], 1e-9), max(hi[2] - lo_[2], 1e-9),
+                              max(hi[1] - lo_[1], 1e-9)))
+        elif st == "quad":
+            c0 = B(sh["corner"])
+            u = B(sh["edge_u"])
+            v = B(sh["edge_v"])
+            co = []
+            for p in (c0, c0 + u, c0 + u + v, c0 + v):
+                co.extend(p)
+            me = ent["mesh"]
+            old = [0.0] * 12
+            me.vertices.foreach_get("co", old)
+            if any(abs(a - b) > 0 for a, b in zip(old, co)):
+                me.vertices.foreach_set("co", co)
+                me.update()
 
-        # objects
-        for ent, o in zip(self.objects, scene.get("objects", [])):
-            name = o.get("name", "?")
-            where = "object '%s'" % name
-            ob = ent["obj"]
-            sh = o["shape"]
-            st = ent["shape"]
-            if st == "sphere":
-                rad = _num(sh, "radius", where + " shape")
-                if rad <= 0:
-                    raise SceneError("%s: radius must be > 0" % where)
-                _set(ob, "location", B(_vec3(sh, "center", where + " shape")))
-                _set(ob, "scale", (rad, rad, rad))
-            elif st == "plane":
-                _set(ob, "location", B(_vec3(sh, "point", where + " shape")))
-                _set(ob, "rotation_quaternion", _rot_z_to(B(_vec3(sh, "normal", where + " shape")), where))
-            elif st == "box":
-                lo_ = _vec3(sh, "min", where + " shape")
-                hi = _vec3(sh, "max", where + " shape")
-                if any(hi[k] < lo_[k] for k in range(3)):
-                    raise SceneError("%s: box max < min" % where)
-                _set(ob, "location", (lo_[0], -hi[2], lo_[1]))
-                # a zero extent would make a singular matrix; keep it tiny instead
-                _set(ob, "scale", (max(hi[0] - lo_[0], 1e-9), max(hi[2] - lo_[2], 1e-9),
-                                  max(hi[1] - lo_[1], 1e-9)))
-            elif st == "quad":
-                c0 = B(_vec3(sh, "corner", where + " shape"))
-                u = B(_vec3(sh, "edge_u", where + " shape"))
-                v = B(_vec3(sh, "edge_v", where + " shape"))
-                if u.cross(v).length < 1e-12:
-                    raise SceneError("%s: quad edges are parallel or zero" % where)
-                co = []
-                for p in (c0, c0 + u, c0 + u + v, c0 + v):
-                    co.extend(p)
-                me = ent["mesh"]
-                old = [0.0] * 12
-                me.vertices.foreach_get("co", old)
-                if any(abs(a - b) > 0 for a, b in zip(old, co)):
-                    me.vertices.foreach_set("co", co)
-                    me.update()
-            self._apply_material(ent, o.get("material", {}), where, scene.get("lights", []))
-
-    def _apply_material(self, ent, m, where, lights):
-        where = where + " material"
-        color = _vec3(m, "color", where)
-        kd = _num(m, "diffuse", where, 1.0)
-        base = (kd * color[0], kd * color[1], kd * color[2], 1.0)
+    def _apply_material(self, ent, m, lights):
+        a = m["albedo"]
+        base = (a[0], a[1], a[2], 1.0)
         nodes = ent["nodes"]
         if ent["kind"] == "lambertian":
             _set(nodes["diffuse"].inputs["Color"], "default_value", base)
             return
         if ent["kind"] == "phong":
-            self._apply_phong(nodes, m, where, base, lights)
+            self._apply_phong(nodes, m, base, lights)
             return
-        ks = _num(m, "specular", where, 0.0)
-        n = _num(m, "shininess", where, 10.0)
-        kr = _num(m, "reflection", where, 0.0)
-        kt = _num(m, "transmission", where, 0.0)
-        ior = _num(m, "ior", where, 1.5)
-        if n < 0:
-            raise SceneError("%s: shininess must be >= 0" % where)
         p = nodes["principled"]
         _set(p.inputs["Base Color"], "default_value", base)
-        _set(p.inputs["Specular"], "default_value", min(1.0, max(0.0, ks)))
-        _set(p.inputs["Roughness"], "default_value", (2.0 / (n + 2.0)) ** 0.25)
-        _set(p.inputs["Transmission"], "default_value", min(1.0, max(0.0, kt)))
-        _set(p.inputs["IOR"], "default_value", ior)
-        _set(nodes["mix"].inputs[0], "default_value", min(1.0, max(0.0, kr)))
+        _set(p.inputs["Specular"], "default_value", min(1.0, max(0.0, m["ks"])))
+        _set(p.inputs["Roughness"], "default_value", roughness(m["n"]))
+        _set(p.inputs["Transmission"], "default_value", min(1.0, max(0.0, m["kt"])))
+        _set(p.inputs["IOR"], "default_value", m["ior"])
+        _set(nodes["mix"].inputs[0], "default_value", min(1.0, max(0.0, m["kr"])))
 
-    def _apply_phong(self, nodes, m, where, base, lights):
-        ks = _num(m, "specular", where, 0.0)
-        n = _num(m, "shininess", where, 10.0)
-        ks2 = _num(m, "specular2", where, 0.0)
-        n2 = _num(m, "shininess2", where, n)
-        kr = _num(m, "reflection", where, 0.0)
-        f0 = _num(m, "fresnel", where, 1.0)
-        if n < 0 or n2 < 0:
-            raise SceneError("%s: shininess must be >= 0" % where)
-        if not 0.0 < f0 <= 1.0:
-            raise SceneError("%s: fresnel must be in (0, 1]" % where)
+    def _apply_phong(self, nodes, m, base, lights):
+        f0 = m["f0"]
         _set(nodes["diffuse"].inputs["Color"], "default_value", base)
         _set(nodes["fresnel"].inputs[1], "default_value", (1.0 - f0) / f0)
-        for (k, g), (ks_, n_) in zip(nodes["lobes"], ((ks, n), (ks2, n2))):
+        for (k, g), (ks_, n_) in zip(nodes["lobes"], ((m["ks"], m["n"]), (m["ks2"], m["n2"]))):
             _set(k.inputs[1], "default_value", max(ks_, 0.0) * (n_ + 8.0) / (n_ + 1.0))
-            _set(g.inputs["Roughness"], "default_value", (2.0 / (n_ + 2.0)) ** 0.25)
-        kr = min(max(kr, 0.0), 1.0)
+            _set(g.inputs["Roughness"], "default_value", roughness(n_))
+        kr = min(max(m["kr"], 0.0), 1.0)
         _set(nodes["mirror"].inputs["Color"], "default_value", (kr, kr, kr, 1.0))
         # the lobe is exact for the first light (the usual single key light)
         at, w = (0.0, 1.0, 0.0), 0.0
         if lights:
             l0 = lights[0]
-            if l0.get("type") == "point":
-                at, w = B(_vec3(l0, "position", "light")), 1.0
+            if l0["type"] == "point":
+                at, w = B(l0["position"]), 1.0
             else:
-                at = B(_vec3(l0, "direction", "light"))
+                at = B(l0["direction"])
         for i, c in enumerate(at):
             _set(nodes["at"].inputs[i], "default_value", c)
         _set(nodes["weight"].inputs["Scale"], "default_value", w)
@@ -867,15 +725,16 @@ class Worker:
         # ~150 ms render (measured, SCENEFIT_WORKER_TIMING=1); the answer
         # then carries no "pixels" and scenefit decodes the PNG.
         t0 = time.perf_counter()
-        structure = structure_of(scene)
+        desc = describe(scene)
+        structure = structure_of(desc)
         if structure != self.structure:
             try:
-                self.build(scene, structure)
+                self.build(structure)
             except Exception:
                 self.clear()
                 raise
         try:
-            self.apply(scene)
+            self.apply(desc)
         except Exception:
             # values may be half-applied; force a rebuild next time
             self.structure = None

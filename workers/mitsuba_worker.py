@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
 """scenefit's Mitsuba 3 worker: a persistent renderer speaking the JSON-lines
-plug-in protocol (docs/plugins.md), spoken by workers/jsonlines.py beside it.
+plug-in protocol (docs/plugins.md), spoken by workers/jsonlines.py beside it;
+the scene is read by workers/scene_common.py (shared with the Blender worker).
 
     python3 workers/mitsuba_worker.py [--variant llvm_ad_rgb|scalar_rgb] [--threads N]
 
@@ -122,6 +123,8 @@ import sys
 import time
 
 import jsonlines
+from scene_common import (SceneError, add, cross, describe, mul, norm, normalize,
+                          roughness, sub)
 
 LLVM19 = "/usr/lib/x86_64-linux-gnu/libLLVM-19.so"
 PLANE_HALF_SIZE = 1000.0
@@ -135,66 +138,8 @@ FREEZE = os.environ.get("SCENEFIT_MITSUBA_FREEZE", "1") != "0"
 DEBUG = bool(os.environ.get("SCENEFIT_WORKER_DEBUG"))
 
 
-class SceneError(jsonlines.RequestError):
-    """A scene this worker cannot build (answered as ok:false)."""
-
-
 # ---------------------------------------------------------------- small vector math
-def vec3(v, where):
-    if not isinstance(v, (list, tuple)) or len(v) != 3:
-        raise SceneError("%s: expected a list of 3 numbers, got %r" % (where, v))
-    try:
-        out = tuple(float(x) for x in v)
-    except (TypeError, ValueError):
-        raise SceneError("%s: expected a list of 3 numbers, got %r" % (where, v))
-    if not all(math.isfinite(x) for x in out):
-        raise SceneError("%s: not finite: %r" % (where, v))
-    return out
-
-
-def num(v, where):
-    if isinstance(v, bool):
-        raise SceneError("%s: expected a number, got %r" % (where, v))
-    try:
-        x = float(v)
-    except (TypeError, ValueError):
-        raise SceneError("%s: expected a number, got %r" % (where, v))
-    if not math.isfinite(x):
-        raise SceneError("%s: not finite: %r" % (where, v))
-    return x
-
-
-def add(a, b):
-    return (a[0] + b[0], a[1] + b[1], a[2] + b[2])
-
-
-def sub(a, b):
-    return (a[0] - b[0], a[1] - b[1], a[2] - b[2])
-
-
-def mul(a, s):
-    return (a[0] * s, a[1] * s, a[2] * s)
-
-
-def dot(a, b):
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-
-
-def cross(a, b):
-    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
-
-
-def norm(a):
-    return math.sqrt(dot(a, a))
-
-
-def normalize(a, where):
-    n = norm(a)
-    if n == 0.0:
-        raise SceneError("%s: zero-length vector" % where)
-    return mul(a, 1.0 / n)
-
-
+# (the scene is read by scene_common.describe, shared with the Blender worker)
 def basis(n):
     """Two unit vectors u, v with (u, v, n) right-handed orthonormal (Duff et al.)."""
     sign = math.copysign(1.0, n[2])
@@ -231,207 +176,111 @@ def look_at_matrix(origin, target, up, sx=1.0, sy=1.0):
 
 
 # ---------------------------------------------------------------- scene -> plan
-def get(d, key, default, where):
-    if not isinstance(d, dict):
-        raise SceneError("%s: expected an object" % where)
-    return d.get(key, default)
-
-
-def material_plan(m, where):
-    if m is None:
-        m = {}
-    if not isinstance(m, dict):
-        raise SceneError("%s: expected an object" % where)
-    if "color" not in m:
-        raise SceneError("%s.color: missing" % where)
-    color = vec3(m["color"], where + ".color")
-    kd = num(m.get("diffuse", 1.0), where + ".diffuse")
-    ks = num(m.get("specular", 0.0), where + ".specular")
-    n = num(m.get("shininess", 10.0), where + ".shininess")
-    kr = num(m.get("reflection", 0.0), where + ".reflection")
-    kt = num(m.get("transmission", 0.0), where + ".transmission")
-    ior = num(m.get("ior", 1.5), where + ".ior")
-    ks2 = num(m.get("specular2", 0.0), where + ".specular2")
-    n2 = num(m.get("shininess2", n), where + ".shininess2")
-    f0 = num(m.get("fresnel", 1.0), where + ".fresnel")
-    albedo = tuple(max(kd * c, 0.0) for c in color)
-    if ks == 0.0 and ks2 == 0.0 and kr == 0.0 and kt == 0.0:
+def material_plan(m):
+    """Mitsuba's values for the convention values `m` (scene_common.material)."""
+    albedo = tuple(max(a, 0.0) for a in m["albedo"])
+    kr, kt = m["kr"], m["kt"]
+    if m["kind"] == "lambertian":
         return {"kind": ("lambert",), "albedo": albedo}
-    if n <= -2.0:
-        raise SceneError("%s.shininess: must be > -2, got %r" % (where, n))
-    if kt > 0.0 and ior <= 0.0:
-        raise SceneError("%s.ior: must be > 0, got %r" % (where, ior))
-    if kt == 0.0:
-        if n < 0.0 or n2 < 0.0:
-            raise SceneError("%s.shininess: must be >= 0, got %r" % (where, min(n, n2)))
-        if not 0.0 < f0 <= 1.0:
-            raise SceneError("%s.fresnel: must be in (0, 1], got %r" % (where, f0))
+    if m["kind"] == "phong":
         # The built-in tracer adds kr * L(mirror); a blend (1-kr) A + kr B
         # adds it too when A is scaled by 1/(1-kr) (kr capped below 1).
         mirror = min(max(kr, 0.0), 0.999)
         return {
             "kind": ("phong", kr > 0.0),
             "albedo": albedo,
-            "ks": max(ks, 0.0), "n": n, "ks2": max(ks2, 0.0), "n2": n2, "f0": f0,
+            "ks": max(m["ks"], 0.0), "n": m["n"], "ks2": max(m["ks2"], 0.0), "n2": m["n2"],
+            "f0": m["f0"],
             "scale": 1.0 / (1.0 - mirror),
             "mirror": mirror,
         }
+    ior = m["ior"]
     return {
         "kind": ("principled", kr > 0.0, kt > 0.0),
         "albedo": albedo,
-        "roughness": min(max((2.0 / (n + 2.0)) ** 0.25, 0.0), 1.0),
-        "specular": min(max(ks, 0.0), 1.0),
+        "roughness": min(max(roughness(m["n"]), 0.0), 1.0),
+        "specular": min(max(m["ks"], 0.0), 1.0),
         "spec_trans": min(max(kt, 0.0), 1.0),
         "eta": ior if ior != 1.0 else 1.0001,
         "mirror": min(max(kr, 0.0), 1.0),
     }
 
 
-def named_entries(scene, key, singular):
-    """(name, "key.name", entry) for each entry of the scene's list `key`;
-    an entry without a name is called singular + its index."""
-    entries = scene.get(key, []) or []
-    if not isinstance(entries, list):
-        raise SceneError("scene.%s: expected a list" % key)
-    for i, entry in enumerate(entries):
-        if not isinstance(entry, dict):
-            raise SceneError("%s[%d]: expected an object" % (key, i))
-        name = str(entry.get("name", "%s%d" % (singular, i)))
-        yield name, "%s.%s" % (key, name), entry
-
-
-def make_plan(scene):
-    """Validate the scene JSON and reduce it to plain numbers.
-    Returns (signature, plan)."""
-    if not isinstance(scene, dict):
-        raise SceneError("scene: expected an object")
-    img = get(scene, "image", None, "scene")
-    if img is None:
-        raise SceneError("scene.image: missing")
-    w = get(img, "width", None, "image")
-    h = get(img, "height", None, "image")
-    if not isinstance(w, int) or not isinstance(h, int) or isinstance(w, bool) or w <= 0 or h <= 0:
-        raise SceneError("scene.image: width and height must be positive integers, got %r x %r" % (w, h))
-    render = scene.get("render", {}) or {}
-    if not isinstance(render, dict):
-        raise SceneError("scene.render: expected an object")
-    spp = render.get("samples", 16)
-    if not isinstance(spp, int) or isinstance(spp, bool) or spp <= 0:
-        raise SceneError("scene.render.samples: must be a positive integer, got %r" % (spp,))
-    indirect = render.get("indirect", True)
-    if not isinstance(indirect, bool):
-        raise SceneError("scene.render.indirect: must be true or false, got %r" % (indirect,))
-
-    cam = scene.get("camera")
-    if not isinstance(cam, dict):
-        raise SceneError("scene.camera: missing or not an object")
-    ctype = cam.get("type", "perspective")
-    pos = vec3(cam.get("position"), "camera.position")
-    target = vec3(cam.get("look_at"), "camera.look_at")
-    up = vec3(cam.get("up", [0, 1, 0]), "camera.up")
-    camera = {"type": ctype}
-    if ctype == "perspective":
-        fov = num(cam.get("fov_y_deg", 40.0), "camera.fov_y_deg")
-        if not 0.0 < fov < 180.0:
-            raise SceneError("camera.fov_y_deg: must be in (0, 180), got %r" % fov)
+def camera_plan(cam, w, h):
+    camera = {"type": cam["type"]}
+    pos, target, up = cam["position"], cam["look_at"], cam["up"]
+    if cam["type"] == "perspective":
+        fov = cam["fov_y"]
         camera["fov_y"] = fov
         camera["x_fov"] = math.degrees(2.0 * math.atan(math.tan(math.radians(fov) / 2.0) * w / h))
         camera["to_world"] = look_at_matrix(pos, target, up)
-    elif ctype == "orthographic":
-        height = num(cam.get("height", 1.0), "camera.height")
-        if height <= 0.0:
-            raise SceneError("camera.height: must be > 0, got %r" % height)
-        s = height * w / (2.0 * h)
-        camera["to_world"] = look_at_matrix(pos, target, up, s, s)
     else:
-        raise SceneError("camera.type: unknown %r (perspective or orthographic)" % (ctype,))
+        s = cam["height"] * w / (2.0 * h)
+        camera["to_world"] = look_at_matrix(pos, target, up, s, s)
+    return camera
 
-    ambient = vec3(scene.get("ambient", [0, 0, 0]), "scene.ambient")
+
+def light_plan(L):
+    name, where = L["name"], "lights." + L["name"]
+    rgb = mul(L["color"], L["intensity"])
+    r = L["radius"]
+    if L["type"] == "point":
+        power, p = L["power"], L["position"]
+        if r > 0.0 and power != 2.0:
+            raise SceneError("%s: an area light (radius > 0) falls off as 1/d^2; "
+                             "falloff_power %r needs radius 0" % (where, power))
+        if power != 2.0:
+            return {"name": name, "type": "falloff_point", "position": p,
+                    "intensity": rgb, "power": power}
+        if r > 0.0:
+            return {"name": name, "type": "sphere_light", "position": p, "radius": r,
+                    "radiance": mul(rgb, 1.0 / (math.pi * r * r))}
+        return {"name": name, "type": "point", "position": p, "intensity": rgb}
+    d = normalize(L["direction"], where + ".direction")
+    if r > 0.0:
+        return {"name": name, "type": "sun", "direction": d, "irradiance": rgb, "radius": r}
+    travel = mul(d, -1.0)
+    u, v = basis(travel)
+    return {"name": name, "type": "directional", "irradiance": rgb,
+            "to_world": columns_matrix(u, v, travel, (0.0, 0.0, 0.0))}
+
+
+def object_plan(o):
+    sh, where = o["shape"], "objects.%s.shape" % o["name"]
+    stype = sh["type"]
+    ob = {"name": o["name"], "shape": stype, "material": material_plan(o["material"])}
+    if stype == "sphere":
+        c, r = sh["center"], sh["radius"]
+        ob["to_world"] = columns_matrix((r, 0, 0), (0, r, 0), (0, 0, r), c)
+    elif stype == "plane":
+        n = normalize(sh["normal"], where + ".normal")
+        u, v = basis(n)
+        ob["to_world"] = columns_matrix(mul(u, PLANE_HALF_SIZE), mul(v, PLANE_HALF_SIZE), n, sh["point"])
+    elif stype == "quad":
+        c, eu, ev = sh["corner"], sh["edge_u"], sh["edge_v"]
+        n = normalize(cross(eu, ev), where + ": edge_u x edge_v")
+        ob["to_world"] = columns_matrix(mul(eu, 0.5), mul(ev, 0.5), n, add(c, mul(add(eu, ev), 0.5)))
+    else:  # box
+        lo, hi = sh["min"], sh["max"]
+        ob["center"] = mul(add(lo, hi), 0.5)
+        ob["half"] = mul(sub(hi, lo), 0.5)
+    return ob
+
+
+def make_plan(scene):
+    """Validate the scene JSON (scene_common.describe) and reduce it to
+    Mitsuba's plain numbers. Returns (signature, plan)."""
+    desc = describe(scene)
+    w, h = desc["width"], desc["height"]
+    ambient = desc["ambient"]
     has_ambient = any(a != 0.0 for a in ambient)
-
-    lights = []
-    for name, where, L in named_entries(scene, "lights", "light"):
-        ltype = L.get("type", "point")
-        color = vec3(L.get("color", [1, 1, 1]), where + ".color")
-        inten = num(L.get("intensity", 1.0), where + ".intensity")
-        rgb = mul(color, inten)
-        if ltype == "point":
-            falloff = L.get("falloff", "inverse_square")
-            if falloff not in ("none", "inverse_square"):
-                raise SceneError("%s.falloff: unknown %r" % (where, falloff))
-            power = 0.0 if falloff == "none" else 2.0
-            if "falloff_power" in L:
-                power = num(L["falloff_power"], where + ".falloff_power")
-            p = vec3(L.get("position"), where + ".position")
-            r = num(L.get("radius", 0.0), where + ".radius")
-            if r < 0.0:
-                raise SceneError("%s.radius: must be >= 0" % where)
-            if r > 0.0 and power != 2.0:
-                raise SceneError("%s: an area light (radius > 0) falls off as 1/d^2; "
-                                 "falloff_power %r needs radius 0" % (where, power))
-            if power != 2.0:
-                lights.append({"name": name, "type": "falloff_point", "position": p,
-                               "intensity": rgb, "power": power})
-            elif r > 0.0:
-                lights.append({"name": name, "type": "sphere_light", "position": p, "radius": r,
-                               "radiance": mul(rgb, 1.0 / (math.pi * r * r))})
-            else:
-                lights.append({"name": name, "type": "point", "position": p, "intensity": rgb})
-        elif ltype == "directional":
-            d = normalize(vec3(L.get("direction"), where + ".direction"), where + ".direction")
-            travel = mul(d, -1.0)
-            u, v = basis(travel)
-            r = num(L.get("radius", 0.0), where + ".radius")
-            if r < 0.0:
-                raise SceneError("%s.radius: must be >= 0" % where)
-            if r > 0.0:
-                lights.append({"name": name, "type": "sun", "direction": d, "irradiance": rgb,
-                               "radius": r})
-            else:
-                lights.append({"name": name, "type": "directional", "irradiance": rgb,
-                               "to_world": columns_matrix(u, v, travel, (0.0, 0.0, 0.0))})
-        else:
-            raise SceneError("%s.type: unknown %r (point or directional)" % (where, ltype))
-
-    objects = []
-    for name, where, O in named_entries(scene, "objects", "object"):
-        sh = O.get("shape")
-        if not isinstance(sh, dict):
-            raise SceneError("%s.shape: missing or not an object" % where)
-        stype = sh.get("type")
-        ob = {"name": name, "shape": stype,
-              "material": material_plan(O.get("material"), where + ".material")}
-        if stype == "sphere":
-            c = vec3(sh.get("center"), where + ".shape.center")
-            r = num(sh.get("radius"), where + ".shape.radius")
-            if r <= 0.0:
-                raise SceneError("%s.shape.radius: must be > 0" % where)
-            ob["to_world"] = columns_matrix((r, 0, 0), (0, r, 0), (0, 0, r), c)
-        elif stype == "plane":
-            p = vec3(sh.get("point"), where + ".shape.point")
-            n = normalize(vec3(sh.get("normal"), where + ".shape.normal"), where + ".shape.normal")
-            u, v = basis(n)
-            ob["to_world"] = columns_matrix(mul(u, PLANE_HALF_SIZE), mul(v, PLANE_HALF_SIZE), n, p)
-        elif stype == "quad":
-            c = vec3(sh.get("corner"), where + ".shape.corner")
-            eu = vec3(sh.get("edge_u"), where + ".shape.edge_u")
-            ev = vec3(sh.get("edge_v"), where + ".shape.edge_v")
-            n = normalize(cross(eu, ev), where + ".shape: edge_u x edge_v")
-            ob["to_world"] = columns_matrix(mul(eu, 0.5), mul(ev, 0.5), n, add(c, mul(add(eu, ev), 0.5)))
-        elif stype == "box":
-            lo = vec3(sh.get("min"), where + ".shape.min")
-            hi = vec3(sh.get("max"), where + ".shape.max")
-            if not all(hi[k] > lo[k] for k in range(3)):
-                raise SceneError("%s.shape: max must exceed min on every axis" % where)
-            ob["center"] = mul(add(lo, hi), 0.5)
-            ob["half"] = mul(sub(hi, lo), 0.5)
-        else:
-            raise SceneError("%s.shape.type: unknown %r (sphere, plane, quad or box)" % (where, stype))
-        objects.append(ob)
-
-    plan = {"width": w, "height": h, "spp": spp, "indirect": indirect, "camera": camera,
-            "ambient": ambient, "has_ambient": has_ambient, "lights": lights, "objects": objects}
-    signature = (w, h, ctype, indirect, has_ambient,
+    lights = [light_plan(L) for L in desc["lights"]]
+    objects = [object_plan(o) for o in desc["objects"]]
+    camera = camera_plan(desc["camera"], w, h)
+    plan = {"width": w, "height": h, "spp": desc["samples"], "indirect": desc["indirect"],
+            "camera": camera, "ambient": ambient, "has_ambient": has_ambient,
+            "lights": lights, "objects": objects}
+    signature = (w, h, camera["type"], desc["indirect"], has_ambient,
                  tuple((L["name"], L["type"]) for L in lights),
                  tuple((o["name"], o["shape"], o["material"]["kind"]) for o in objects))
     return signature, plan

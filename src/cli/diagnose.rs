@@ -67,7 +67,7 @@ pub fn run(a: DiagnoseArgs) -> Result<()> {
     }
     let mut config = DiagnoseConfig {
         renderer: a.renderer,
-        render_options: a.render_options.options_in(&a.output),
+        render_options: a.render_options.options_in(&a.output)?,
         population: a.population,
         search_generations: a.generations / 2,
         refine_generations: a.generations - a.generations / 2,

@@ -124,7 +124,7 @@ pub fn run(a: FitArgs) -> Result<()> {
         return Ok(());
     }
     let (target, note) = a.inputs.target(&scene)?;
-    let renderer = from_spec_with(&a.renderer, &a.render_options.options_in(&a.output))?;
+    let renderer = from_spec_with(&a.renderer, &a.render_options.options_in(&a.output)?)?;
     let mut config = a.search.config(renderer.default_jobs())?;
     let file = a.inputs.scene.display().to_string();
     let (w, h) = (scene.image.width, scene.image.height);
@@ -171,7 +171,7 @@ pub fn run(a: FitArgs) -> Result<()> {
 
 /// `fit --shots`: one fit of every photograph of a set.
 fn run_set(a: &FitArgs, scene: &Scene, shots: &[crate::fit::set::shots::Shot]) -> Result<()> {
-    let renderer = from_spec_with(&a.renderer, &a.render_options.options_in(&a.output))?;
+    let renderer = from_spec_with(&a.renderer, &a.render_options.options_in(&a.output)?)?;
     let mut config = a.search.config(renderer.default_jobs())?;
     let file = a.inputs.scene.display().to_string();
     let (w, h) = (scene.image.width, scene.image.height);

@@ -4,6 +4,7 @@
 
 mod demo;
 mod diagnose;
+mod env;
 mod fit;
 mod pipeline;
 mod progress;

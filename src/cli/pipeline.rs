@@ -97,12 +97,10 @@ struct MethodArgs {
 }
 
 pub fn run(a: PipelineArgs) -> Result<()> {
-    if let Some(f) = &a.font {
-        report::font::use_file(f.clone());
-    }
+    super::env::use_font(a.font.clone());
     let scene = load_with(&a.inputs.scene, &a.set)?;
     let (target, note) = a.inputs.target(&scene)?;
-    let opts = a.render_options.options_in(&a.output);
+    let opts = a.render_options.options_in(&a.output)?;
     let r1 = renderer(&a.stage1, "--stage1", &opts)?;
     let r2 = renderer(&a.stage2, "--stage2", &opts)?;
     let interrupt = interrupt_flag();

@@ -57,7 +57,7 @@ pub fn run(a: RenderArgs) -> Result<()> {
         }
     }
     let scene = load_with(&a.scene, &set)?;
-    let renderer = from_spec_with(&a.renderer, &a.render_options.options())?;
+    let renderer = from_spec_with(&a.renderer, &a.render_options.options()?)?;
     let img = render_one(renderer.as_ref(), &scene, a.seed)?;
     image_io::write_image(&img, &a.output)
 }

@@ -3,6 +3,7 @@
 //! environment variable, which overrides the backend's default. Also where
 //! the renderer processes run (`--executor`, `--workers`, `--slurm-args`).
 
+use crate::error::Result;
 use crate::exec::slurm;
 use crate::exec::Executor;
 use crate::render::RenderOptions;
@@ -55,9 +56,10 @@ pub struct RendererArgs {
 struct SlurmArgs(Vec<String>);
 
 impl RendererArgs {
-    /// The library's form of these options.
-    pub fn options(&self) -> RenderOptions {
-        RenderOptions {
+    /// The library's form of these options, the environment filling what
+    /// the flags left unset (`env.rs`).
+    pub fn options(&self) -> Result<RenderOptions> {
+        super::env::render_options(RenderOptions {
             render_timeout: self.render_timeout,
             worker_max_renders: self.worker_max_renders,
             python: self.python.clone(),
@@ -69,30 +71,31 @@ impl RendererArgs {
                 },
             },
             slurm_ledger: None,
-        }
+        })
     }
 
     /// `options()` for a run into `run_dir`: its Slurm jobs are recorded
     /// there, and what a killed run there left on Slurm is cancelled now.
-    pub fn options_in(&self, run_dir: &Path) -> RenderOptions {
+    pub fn options_in(&self, run_dir: &Path) -> Result<RenderOptions> {
+        let options = self.options()?;
         let ledger = run_dir.join(crate::rundir::SLURM_JOBS);
         slurm::clean_ledger(&ledger);
-        RenderOptions {
+        Ok(RenderOptions {
             slurm_ledger: Some(ledger),
-            ..self.options()
-        }
+            ..options
+        })
     }
 }
 
-fn slurm_args(s: &str) -> Result<SlurmArgs, String> {
+fn slurm_args(s: &str) -> std::result::Result<SlurmArgs, String> {
     slurm::split_args(s).map(SlurmArgs)
 }
 
-fn seconds(s: &str) -> Result<Duration, String> {
+fn seconds(s: &str) -> std::result::Result<Duration, String> {
     crate::exec::parse_seconds(s).ok_or_else(|| "expected a number of seconds > 0, e.g. 120".into())
 }
 
-fn at_least_one(s: &str) -> Result<usize, String> {
+fn at_least_one(s: &str) -> std::result::Result<usize, String> {
     s.trim()
         .parse::<usize>()
         .ok()

@@ -27,9 +27,7 @@ pub struct ReportArgs {
 }
 
 pub fn run(a: ReportArgs) -> Result<()> {
-    if let Some(f) = a.font {
-        report::font::use_file(f);
-    }
+    super::env::use_font(a.font);
     let path = report::write(
         &a.dir,
         &ReportOptions {

@@ -32,11 +32,6 @@ pub use result::{RenderFailure, RenderResult};
 use std::path::PathBuf;
 use std::time::Duration;
 
-/// Environment variable: per-render timeout in seconds (all backends).
-pub const ENV_RENDER_TIMEOUT: &str = "SCENEFIT_RENDER_TIMEOUT";
-/// Environment variable: renders a persistent worker serves before it is restarted.
-pub const ENV_MAX_RENDERS: &str = "SCENEFIT_WORKER_MAX_RENDERS";
-
 /// How renderer processes are run.
 #[derive(Clone, Debug)]
 pub struct ExecConfig {
@@ -55,42 +50,33 @@ pub struct ExecConfig {
     pub launcher: Launcher,
 }
 
-/// What the caller chose over the environment and the backend's defaults
-/// (the command line's flags); None leaves the choice to them.
+/// How renderer processes run, as the caller chose (the command line's
+/// flags over its environment variables, both read in `cli::env`, the only
+/// place that reads the environment); each None leaves the choice to the
+/// backend's default.
 #[derive(Clone, Debug, Default, PartialEq)]
-pub struct ExecOverrides {
+pub struct RenderOptions {
+    /// One render may take this long; then its process is killed.
     pub render_timeout: Option<Duration>,
-    pub max_renders: Option<usize>,
-    /// Processes or workers at once, over what the session asks for.
+    /// A persistent worker is restarted after this many renders.
+    pub worker_max_renders: Option<usize>,
+    /// The Python that runs a Python worker (Mitsuba's).
+    pub python: Option<PathBuf>,
+    /// Renderer processes or workers at once, over the session's number.
     pub workers: Option<usize>,
+    /// Where renderer processes run (local, or Slurm tasks).
     pub executor: Executor,
-    /// The run directory's record of the run's Slurm jobs.
+    /// The run directory's record of its Slurm jobs (`rundir::SLURM_JOBS`).
     pub slurm_ledger: Option<PathBuf>,
 }
 
 impl ExecConfig {
-    /// The backend's defaults, overridden by `SCENEFIT_RENDER_TIMEOUT` and
-    /// `SCENEFIT_WORKER_MAX_RENDERS` when set.
-    pub fn from_env(
-        jobs: usize,
-        render_timeout: Duration,
-        startup_timeout: Duration,
-    ) -> Result<ExecConfig> {
-        ExecConfig::new(
-            jobs,
-            render_timeout,
-            startup_timeout,
-            &ExecOverrides::default(),
-        )
-    }
-
-    /// The backend's defaults, overridden by the environment variables,
-    /// overridden by `over`.
+    /// The backend's defaults, overridden by the caller's options.
     pub fn new(
         jobs: usize,
         render_timeout: Duration,
         startup_timeout: Duration,
-        over: &ExecOverrides,
+        over: &RenderOptions,
     ) -> Result<ExecConfig> {
         if over.workers == Some(0) {
             return Err(Error::Usage(
@@ -105,7 +91,6 @@ impl ExecConfig {
             retries: 1,
             launcher: Launcher::default(),
         };
-        c.apply_env(over)?;
         if let Some(t) = over.render_timeout {
             if t.is_zero() {
                 return Err(Error::Usage(
@@ -114,7 +99,7 @@ impl ExecConfig {
             }
             c.render_timeout = t;
         }
-        if let Some(n) = over.max_renders {
+        if let Some(n) = over.worker_max_renders {
             if n == 0 {
                 return Err(Error::Usage(
                     "worker max renders: expected a whole number of renders >= 1, e.g. 200".into(),
@@ -125,37 +110,6 @@ impl ExecConfig {
         c.launcher = Launcher::new(&over.executor, over.slurm_ledger.clone())?;
         Ok(c)
     }
-
-    /// The environment's settings, but not those `over` replaces (an
-    /// unusable value there is then no error).
-    fn apply_env(&mut self, over: &ExecOverrides) -> Result<()> {
-        let c = self;
-        let env = |key: &str, overridden: bool| (!overridden).then(|| env_value(key)).flatten();
-        if let Some(s) = env(ENV_RENDER_TIMEOUT, over.render_timeout.is_some()) {
-            c.render_timeout = parse_seconds(&s).ok_or_else(|| {
-                Error::Usage(format!(
-                    "{ENV_RENDER_TIMEOUT}={s}: expected a number of seconds > 0, e.g. 120"
-                ))
-            })?;
-        }
-        if let Some(s) = env(ENV_MAX_RENDERS, over.max_renders.is_some()) {
-            c.max_renders = s
-                .trim()
-                .parse::<usize>()
-                .ok()
-                .filter(|n| *n > 0)
-                .ok_or_else(|| {
-                    Error::Usage(format!(
-                        "{ENV_MAX_RENDERS}={s}: expected a whole number of renders >= 1, e.g. 200"
-                    ))
-                })?;
-        }
-        Ok(())
-    }
-}
-
-fn env_value(key: &str) -> Option<String> {
-    std::env::var(key).ok().filter(|s| !s.trim().is_empty())
 }
 
 /// A number of seconds > 0 (and finite), as the environment and the
@@ -193,9 +147,9 @@ mod tests {
     #[test]
     fn overrides_win_and_are_checked() {
         let d = Duration::from_secs(7);
-        let over = ExecOverrides {
+        let over = RenderOptions {
             render_timeout: Some(Duration::from_secs(3)),
-            max_renders: Some(5),
+            worker_max_renders: Some(5),
             workers: Some(4),
             ..Default::default()
         };
@@ -205,7 +159,7 @@ mod tests {
             (Duration::from_secs(3), 5, 4)
         );
         assert!(!c.launcher.is_slurm());
-        let zero = ExecOverrides {
+        let zero = RenderOptions {
             render_timeout: Some(Duration::ZERO),
             ..Default::default()
         };

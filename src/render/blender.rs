@@ -14,7 +14,8 @@
 //! Principled BSDF for glass). `render.antialias` and `render.max_depth`
 //! are the built-in tracer's and unused here.
 
-use super::external::{python_worker_dir, ExternalSession};
+use super::registry::Backend;
+use super::worker_start::PythonWorker;
 use super::{RenderSession, Renderer};
 use crate::error::Result;
 use crate::exec::discover;
@@ -22,14 +23,25 @@ use crate::exec::process::CommandSpec;
 use crate::scene::{ParamSpace, Scene};
 use std::time::Duration;
 
-/// The worker script, as shipped in blender_scripts/.
-const WORKER: &str = include_str!("../../blender_scripts/worker.py");
+/// The registry's entry (`registry::ALL`).
+pub const BACKEND: Backend = Backend {
+    name: "blender",
+    arg: None,
+    about: "Blender's Cycles path tracer, through persistent headless Blender workers",
+    build: |_, opts| Box::new(Blender(opts)),
+    supports: super::pbr_fields::blender,
+};
 
-/// Default per-render timeout: a 128x96 render takes ~0.1 s; big images
-/// with many samples take minutes.
-const RENDER_TIMEOUT: Duration = Duration::from_secs(600);
-/// Blender's start-up: over a second alone, more on a busy machine.
-const STARTUP_TIMEOUT: Duration = Duration::from_secs(120);
+/// The worker as shipped in blender_scripts/, with its process limits:
+/// a 128x96 render takes ~0.1 s, big images with many samples minutes;
+/// Blender's start-up over a second alone, more on a busy machine.
+const WORKER: PythonWorker = PythonWorker {
+    name: "blender",
+    file: "blender_worker.py",
+    script: include_str!("../../blender_scripts/worker.py"),
+    timeouts: (Duration::from_secs(600), Duration::from_secs(120)),
+    max_renders: None,
+};
 
 /// The Blender backend, with the caller's process options.
 pub struct Blender(pub super::RenderOptions);
@@ -41,35 +53,30 @@ impl Renderer for Blender {
 
     fn session(
         &self,
-        base: &Scene,
+        _base: &Scene,
         _varying: &ParamSpace,
         jobs: usize,
     ) -> Result<Box<dyn RenderSession>> {
-        super::pbr_fields::check(base, "blender")?;
         let program = discover::find("blender", &discover::apt_hint("blender"))?;
-        let (cfg, dir, script) = python_worker_dir(
-            jobs,
-            (RENDER_TIMEOUT, STARTUP_TIMEOUT),
-            &self.0,
-            "blender_worker.py",
-            WORKER,
-        )?;
-        let spec = CommandSpec::new(program)
-            .cwd(dir.path())
-            // Blender makes a temp dir per process and leaves it when killed
-            // (restarts, timeouts): keep those inside the run's own dir.
-            .env("TMPDIR", dir.path())
-            .args([
-                "-b",
-                "--factory-startup",
-                "-noaudio",
-                "--python-exit-code",
-                "1",
-                "-P",
-            ])
-            .arg(script)
-            .args(["--", "--threads", "1"]);
-        match ExternalSession::persistent("blender", spec, cfg, dir) {
+        let command = |dir: &std::path::Path, script| {
+            CommandSpec::new(program)
+                .cwd(dir)
+                // Blender makes a temp dir per process and leaves it when
+                // killed (restarts, timeouts): keep those inside the run's
+                // own dir.
+                .env("TMPDIR", dir)
+                .args([
+                    "-b",
+                    "--factory-startup",
+                    "-noaudio",
+                    "--python-exit-code",
+                    "1",
+                    "-P",
+                ])
+                .arg(script)
+                .args(["--", "--threads", "1"])
+        };
+        match WORKER.start(jobs, &self.0, command) {
             Ok(s) => Ok(Box::new(s)),
             Err((e, _)) => Err(e),
         }

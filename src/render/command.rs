@@ -12,6 +12,7 @@
 //! command work as typed. Every scene field is passed through unchanged.
 
 use super::external::{session_dir, ExternalSession, OneShotBackend};
+use super::registry::Backend;
 use super::{RenderOptions, RenderSession, Renderer};
 use crate::error::{Error, Result};
 use crate::exec::discover;
@@ -19,6 +20,24 @@ use crate::exec::process::CommandSpec;
 use crate::scene::{ParamSpace, Scene};
 use std::path::{Path, PathBuf};
 use std::time::Duration;
+
+/// The registry's entry for `cmd:TEMPLATE`: every field is passed on.
+pub const ONE_SHOT: Backend = Backend {
+    name: "cmd:",
+    arg: Some("TEMPLATE"),
+    about: "any program, one process per render (docs/plugins.md)",
+    build: |template, opts| Box::new(Command::one_shot(template, opts)),
+    supports: |_| Vec::new(),
+};
+
+/// The registry's entry for `worker:COMMAND`: every field is passed on.
+pub const WORKER: Backend = Backend {
+    name: "worker:",
+    arg: Some("COMMAND"),
+    about: "any program as a persistent worker speaking JSON lines (docs/plugins.md)",
+    build: |command, opts| Box::new(Command::worker(command, opts)),
+    supports: |_| Vec::new(),
+};
 
 /// Default per-render timeout of plug-ins (a plug-in's speed is unknown).
 const RENDER_TIMEOUT: Duration = Duration::from_secs(300);

@@ -58,16 +58,6 @@ fn run_dir() -> Result<TempDir> {
     Ok(dir)
 }
 
-/// Writes an embedded script into the run directory.
-fn write_script(dir: &TempDir, name: &str, text: &str) -> Result<PathBuf> {
-    let path = dir.path().join(name);
-    std::fs::write(&path, text).map_err(|e| Error::io(&path, e))?;
-    Ok(path)
-}
-
-/// The JSON-lines protocol module the Python workers import, written beside them.
-const PROTOCOL: &str = include_str!("../../workers/jsonlines.py");
-
 /// A backend's process limits (its default render and start-up timeouts,
 /// overridden by the caller's options) and the run's private directory.
 pub fn session_dir(
@@ -75,25 +65,10 @@ pub fn session_dir(
     (render_timeout, startup_timeout): (Duration, Duration),
     opts: &RenderOptions,
 ) -> Result<(ExecConfig, TempDir)> {
-    let cfg = ExecConfig::new(jobs, render_timeout, startup_timeout, &opts.exec())?;
+    let cfg = ExecConfig::new(jobs, render_timeout, startup_timeout, opts)?;
     let dir = run_dir()?;
     cfg.launcher.use_dir(dir.path());
     Ok((cfg, dir))
-}
-
-/// [`session_dir`] with a Python worker written into the directory as
-/// `name`, beside the protocol module it imports; also the worker's path.
-pub fn python_worker_dir(
-    jobs: usize,
-    timeouts: (Duration, Duration),
-    opts: &RenderOptions,
-    name: &str,
-    worker: &str,
-) -> Result<(ExecConfig, TempDir, PathBuf)> {
-    let (cfg, dir) = session_dir(jobs, timeouts, opts)?;
-    write_script(&dir, "jsonlines.py", PROTOCOL)?;
-    let script = write_script(&dir, name, worker)?;
-    Ok((cfg, dir, script))
 }
 
 impl ExternalSession {

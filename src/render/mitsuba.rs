@@ -2,7 +2,7 @@
 //! persistent worker `workers/mitsuba_worker.py` (embedded in the binary and
 //! written into the run's temporary directory) as `python3
 //! mitsuba_worker.py --threads 1`; `RenderOptions::python` (the command
-//! line's `--python`), else `SCENEFIT_PYTHON`, names another Python.
+//! line's `--python` or `SCENEFIT_PYTHON`) names another Python.
 //! The worker keeps the loaded scene and only updates changed values.
 //!
 //! Scene fields: all but what `pbr_fields.rs` refuses, mapped by the worker
@@ -14,31 +14,38 @@
 //! worker's own `scenefit_phong` BSDF; principled for glass).
 //! `render.antialias` and `render.max_depth` are unused here.
 
-use super::external::{python_worker_dir, ExternalSession};
+use super::registry::Backend;
+use super::worker_start::PythonWorker;
 use super::{RenderSession, Renderer};
 use crate::error::{Error, Result};
+use crate::exec::discover;
 use crate::exec::process::CommandSpec;
-use crate::exec::{discover, ENV_MAX_RENDERS};
 use crate::scene::{ParamSpace, Scene};
 use std::time::Duration;
 
-/// The worker script, as shipped in workers/.
-const WORKER: &str = include_str!("../../workers/mitsuba_worker.py");
+/// The registry's entry (`registry::ALL`).
+pub const BACKEND: Backend = Backend {
+    name: "mitsuba",
+    arg: None,
+    about: "Mitsuba 3's path tracer (CPU, LLVM), through persistent Python workers",
+    build: |_, opts| Box::new(Mitsuba(opts)),
+    supports: super::pbr_fields::mitsuba,
+};
 
-/// Environment variable: the Python that runs the worker (default python3).
-pub const ENV_PYTHON: &str = "SCENEFIT_PYTHON";
-
-/// Default per-render timeout: a 128x96 render takes ~15 ms, a new scene
-/// structure a JIT compile of ~0.3 s; big images with many samples minutes.
-const RENDER_TIMEOUT: Duration = Duration::from_secs(300);
-/// Importing Mitsuba and starting LLVM.
-const STARTUP_TIMEOUT: Duration = Duration::from_secs(60);
-
-/// Renders a worker serves before it is restarted, unless the caller
-/// chose: a restart costs ~0.5 s of CPU (importing Mitsuba, starting LLVM,
-/// the first kernel), 2.5 ms a render at the general default of 200, and
-/// the worker's memory stayed flat over 1200 renders (measured).
-const MAX_RENDERS: usize = 2000;
+/// The worker as shipped in workers/, with its process limits: a 128x96
+/// render takes ~15 ms, a new scene structure a JIT compile of ~0.3 s, big
+/// images with many samples minutes; start-up is importing Mitsuba and
+/// starting LLVM. A restart costs ~0.5 s of CPU (importing Mitsuba,
+/// starting LLVM, the first kernel), 2.5 ms a render at 200 renders a
+/// worker, and the worker's memory stayed flat over 1200 renders
+/// (measured): hence 2000 renders unless the caller chooses.
+const WORKER: PythonWorker = PythonWorker {
+    name: "mitsuba",
+    file: "mitsuba_worker.py",
+    script: include_str!("../../workers/mitsuba_worker.py"),
+    timeouts: (Duration::from_secs(300), Duration::from_secs(60)),
+    max_renders: Some(2000),
+};
 
 const INSTALL: &str = "install it with `python3 -m pip install mitsuba` (and `apt-get install libllvm19`) or run scripts/install-renderers.sh";
 
@@ -52,40 +59,25 @@ impl Renderer for Mitsuba {
 
     fn session(
         &self,
-        base: &Scene,
+        _base: &Scene,
         _varying: &ParamSpace,
         jobs: usize,
     ) -> Result<Box<dyn RenderSession>> {
-        super::pbr_fields::check(base, "mitsuba")?;
         let python = match &self.0.python {
             Some(p) => p.to_string_lossy().into_owned(),
-            None => std::env::var(ENV_PYTHON)
-                .ok()
-                .filter(|s| !s.trim().is_empty())
-                .unwrap_or_else(|| "python3".into()),
+            None => "python3".into(),
         };
         let program = discover::find(
             &python,
-            &format!(
-                "name a Python 3 with Mitsuba (the Python option or {ENV_PYTHON}), or {INSTALL}"
-            ),
+            &format!("name a Python 3 with Mitsuba (--python or SCENEFIT_PYTHON), or {INSTALL}"),
         )?;
-        let (mut cfg, dir, script) = python_worker_dir(
-            jobs,
-            (RENDER_TIMEOUT, STARTUP_TIMEOUT),
-            &self.0,
-            "mitsuba_worker.py",
-            WORKER,
-        )?;
-        let chosen = std::env::var(ENV_MAX_RENDERS).is_ok_and(|v| !v.trim().is_empty());
-        if self.0.worker_max_renders.is_none() && !chosen {
-            cfg.max_renders = MAX_RENDERS;
-        }
-        let spec = CommandSpec::new(program)
-            .cwd(dir.path())
-            .arg(script)
-            .args(["--threads", "1"]);
-        match ExternalSession::persistent("mitsuba", spec, cfg, dir) {
+        let command = |dir: &std::path::Path, script| {
+            CommandSpec::new(program)
+                .cwd(dir)
+                .arg(script)
+                .args(["--threads", "1"])
+        };
+        match WORKER.start(jobs, &self.0, command) {
             Ok(s) => Ok(Box::new(s)),
             Err((_, f))
                 if f.stderr.contains("No module named 'mitsuba'")

@@ -1,7 +1,8 @@
 //! Renderers: the `Renderer` trait every backend implements, and the choice
 //! of backend from a name (`phong`, `povray`, `blender`, `mitsuba`,
-//! `cmd:TEMPLATE`, `worker:COMMAND`). Nothing outside this module knows
-//! which backend runs.
+//! `cmd:TEMPLATE`, `worker:COMMAND`) through the list of backends
+//! (`registry`), which also says what each cannot draw. Nothing outside
+//! this module knows which backend runs.
 
 pub mod camera_effects;
 pub mod phong;
@@ -15,14 +16,15 @@ pub mod near_lights;
 pub mod pbr_fields;
 pub mod pov_sdl;
 pub mod povray;
+#[cfg(test)]
+mod refusal_table;
+pub mod registry;
+pub mod worker_start;
 
 use crate::error::{Error, Result};
-use crate::exec::{ExecOverrides, Executor};
 use crate::scene::{ParamSpace, Scene};
-use std::path::PathBuf;
-use std::time::Duration;
 
-pub use crate::exec::{RenderFailure, RenderResult};
+pub use crate::exec::{RenderFailure, RenderOptions, RenderResult};
 pub use crate::raster::Image;
 
 /// A backend. `session` prepares it to render many variants of one scene.
@@ -58,66 +60,16 @@ pub trait RenderSession: Send {
     fn render_batch(&mut self, scenes: &[Scene], seed: u64) -> Vec<RenderResult>;
 }
 
-/// How the process-backed renderers run, over their defaults. Each field
-/// left None falls back to its environment variable
-/// (`SCENEFIT_RENDER_TIMEOUT`, `SCENEFIT_WORKER_MAX_RENDERS`,
-/// `SCENEFIT_PYTHON`), then to the backend's default.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct RenderOptions {
-    /// One render may take this long; then its process is killed.
-    pub render_timeout: Option<Duration>,
-    /// A persistent worker is restarted after this many renders.
-    pub worker_max_renders: Option<usize>,
-    /// The Python that runs the Mitsuba worker.
-    pub python: Option<PathBuf>,
-    /// Renderer processes or workers at once, over the session's number.
-    pub workers: Option<usize>,
-    /// Where renderer processes run (local, or Slurm tasks).
-    pub executor: Executor,
-    /// The run directory's record of its Slurm jobs (`rundir::SLURM_JOBS`).
-    pub slurm_ledger: Option<PathBuf>,
-}
-
-impl RenderOptions {
-    /// The part the process layer applies.
-    pub fn exec(&self) -> ExecOverrides {
-        ExecOverrides {
-            render_timeout: self.render_timeout,
-            max_renders: self.worker_max_renders,
-            workers: self.workers,
-            executor: self.executor.clone(),
-            slurm_ledger: self.slurm_ledger.clone(),
-        }
-    }
-}
-
 /// The backend named by `spec` (see the module doc), followed by the
-/// camera's image-space effects (`camera_effects.rs`), with the defaults
-/// and the environment's settings.
+/// camera's image-space effects (`camera_effects.rs`), with the defaults.
 pub fn from_spec(spec: &str) -> Result<Box<dyn Renderer>> {
     from_spec_with(spec, &RenderOptions::default())
 }
 
-/// `from_spec` with `opts` over the environment and the defaults.
+/// `from_spec` with the caller's options over the defaults.
 pub fn from_spec_with(spec: &str, opts: &RenderOptions) -> Result<Box<dyn Renderer>> {
-    let drawn = near_lights::WithNearLights(backend(spec, opts)?);
+    let drawn = near_lights::WithNearLights(registry::build(spec, opts)?);
     Ok(Box::new(camera_effects::WithCameraEffects(Box::new(drawn))))
-}
-
-/// The bare backend named by `spec`.
-fn backend(spec: &str, opts: &RenderOptions) -> Result<Box<dyn Renderer>> {
-    let o = opts.clone();
-    match spec {
-        "phong" => Ok(Box::new(phong::Phong)),
-        "povray" => Ok(Box::new(povray::PovRay(o))),
-        "blender" => Ok(Box::new(blender::Blender(o))),
-        "mitsuba" => Ok(Box::new(mitsuba::Mitsuba(o))),
-        s if s.starts_with("cmd:") => Ok(Box::new(command::Command::one_shot(&s["cmd:".len()..], o))),
-        s if s.starts_with("worker:") => Ok(Box::new(command::Command::worker(&s["worker:".len()..], o))),
-        other => Err(Error::Usage(format!(
-            "--renderer {other}: unknown renderer; expected phong, povray, blender, mitsuba, cmd:TEMPLATE or worker:COMMAND"
-        ))),
-    }
 }
 
 /// Renders one scene once (for `scenefit render`).

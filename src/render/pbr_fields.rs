@@ -13,14 +13,24 @@
 //! (the built-in tracer's grazing factor of the diffuse term). `indirect_light` is the built-in
 //! tracer's stand-in for what `render.indirect` traces: not refused.
 
-use crate::error::{Error, Result};
+use super::registry::Refusal;
 use crate::scene::{Falloff, LightKind, Scene};
 
-/// Err naming the first field `backend` ("blender" or "mitsuba") cannot
-/// render.
-pub fn check(scene: &Scene, backend: &str) -> Result<()> {
-    let refuse = |field: String, why: &str| Err(Error::Usage(format!("{backend}: {field}: {why}")));
-    let mitsuba = backend == "mitsuba";
+/// What the Blender worker cannot draw (`registry::Backend::supports`).
+pub fn blender(scene: &Scene) -> Vec<Refusal> {
+    refusals(scene, false)
+}
+
+/// What the Mitsuba worker cannot draw (`registry::Backend::supports`).
+pub fn mitsuba(scene: &Scene) -> Vec<Refusal> {
+    refusals(scene, true)
+}
+
+/// Every field either worker cannot draw; `mitsuba` adds what only
+/// Mitsuba cannot (area lights are shapes there).
+fn refusals(scene: &Scene, mitsuba: bool) -> Vec<Refusal> {
+    let mut out = Vec::new();
+    let mut refuse = |field: String, why: &str| out.push(Refusal::new(field, why));
     for l in &scene.lights {
         if !mitsuba || l.radius <= 0.0 || l.kind != LightKind::Point {
             continue;
@@ -30,7 +40,7 @@ pub fn check(scene: &Scene, backend: &str) -> Result<()> {
             Falloff::None => 0.0,
         });
         if power != 2.0 {
-            return refuse(
+            refuse(
                 format!("lights.{}.radius", l.name),
                 "an area light falls off as 1/d^2 here; with falloff_power or falloff \"none\" use radius 0, or phong or blender",
             );
@@ -39,13 +49,13 @@ pub fn check(scene: &Scene, backend: &str) -> Result<()> {
     for o in &scene.objects {
         let m = &o.material;
         if m.albedo_map.is_some() {
-            return refuse(
+            refuse(
                 format!("objects.{}.material.albedo_map", o.name),
                 "an albedo map in the image's frame is drawn by phong only; use phong",
             );
         }
         if m.diffuse_f90.is_some_and(|f| f != 1.0) {
-            return refuse(
+            refuse(
                 format!("objects.{}.material.diffuse_f90", o.name),
                 "the grazing factor of the diffuse term is drawn by phong only; use phong",
             );
@@ -54,19 +64,19 @@ pub fn check(scene: &Scene, backend: &str) -> Result<()> {
             continue;
         }
         if m.specular2.is_some_and(|k| k > 0.0) {
-            return refuse(
+            refuse(
                 format!("objects.{}.material.specular2", o.name),
                 "a second lobe on a transmitting material is not supported; use phong",
             );
         }
         if m.fresnel.is_some_and(|f| f != 1.0) {
-            return refuse(
+            refuse(
                 format!("objects.{}.material.fresnel", o.name),
                 "a transmitting material takes its Fresnel term from `ior`; remove `fresnel` or use phong",
             );
         }
     }
-    Ok(())
+    out
 }
 
 #[cfg(test)]
@@ -77,13 +87,15 @@ mod tests {
     fn a_grazing_factor_is_refused_by_every_other_backend_naming_the_field() {
         let mut scene = crate::scene::test_scene::ball(r#""color": [0.5, 0.5, 0.5]"#, "");
         scene.objects[0].material.diffuse_f90 = Some(1.0);
-        assert!(check(&scene, "mitsuba").is_ok(), "1 is Lambertian");
+        assert!(mitsuba(&scene).is_empty(), "1 is Lambertian");
         scene.objects[0].material.diffuse_f90 = Some(0.4);
-        for backend in ["blender", "mitsuba"] {
-            let e = check(&scene, backend).unwrap_err().to_string();
-            assert!(e.contains("material.diffuse_f90"), "{e}");
+        let pov = crate::render::pov_sdl::refusals(&scene);
+        for refused in [blender(&scene), mitsuba(&scene), pov] {
+            assert_eq!(refused.len(), 1, "{refused:?}");
+            assert!(
+                refused[0].field.ends_with("material.diffuse_f90"),
+                "{refused:?}"
+            );
         }
-        let e = crate::render::pov_sdl::check(&scene).unwrap_err();
-        assert!(e.contains("material.diffuse_f90"), "{e}");
     }
 }

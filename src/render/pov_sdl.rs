@@ -38,6 +38,7 @@
 //!   whatever its transparency (measured: the same image as the lobe in the
 //!   bottom finish).
 
+use super::registry::Refusal;
 use crate::scene::{CameraKind, Falloff, LightKind, Material, Scene, ShapeKind, Vec3};
 use std::f64::consts::PI;
 use std::fmt::Write;
@@ -85,49 +86,53 @@ fn rgb(c: Vec3, scale: f64) -> String {
 }
 
 /// What POV-Ray cannot render of `scene`, if anything.
-pub fn check(scene: &Scene) -> Result<(), String> {
+pub fn refusals(scene: &Scene) -> Vec<Refusal> {
+    let mut out = Vec::new();
     if scene.render.max_depth > 254 {
-        return Err(format!(
-            "render.max_depth {}: POV-Ray traces at most 255 levels",
-            scene.render.max_depth
+        out.push(Refusal::new(
+            "render.max_depth",
+            format!(
+                "{} asked; POV-Ray traces at most 255 levels",
+                scene.render.max_depth
+            ),
         ));
     }
     for l in &scene.lights {
         if l.kind == LightKind::Directional && l.radius > 0.0 {
-            return Err(format!(
-                "lights.{}.radius: a directional light of angular size is not supported (POV-Ray's parallel lights are points at infinity); use phong or blender",
-                l.name
+            out.push(Refusal::new(
+                format!("lights.{}.radius", l.name),
+                "a directional light of angular size is not supported (POV-Ray's parallel lights are points at infinity); use phong or blender",
             ));
         }
     }
     for o in &scene.objects {
         let m = &o.material;
         if m.albedo_map.is_some() {
-            return Err(format!(
-                "objects.{}.material.albedo_map: an albedo map in the image's frame is drawn by phong only; use phong",
-                o.name
+            out.push(Refusal::new(
+                format!("objects.{}.material.albedo_map", o.name),
+                "an albedo map in the image's frame is drawn by phong only; use phong",
             ));
         }
         if m.fresnel.is_some_and(|f| f != 1.0) {
-            return Err(format!(
-                "objects.{}.material.fresnel: not supported (POV-Ray's specular highlight has no Fresnel term); use phong, blender or mitsuba",
-                o.name
+            out.push(Refusal::new(
+                format!("objects.{}.material.fresnel", o.name),
+                "not supported (POV-Ray's specular highlight has no Fresnel term); use phong, blender or mitsuba",
             ));
         }
         if m.diffuse_f90.is_some_and(|f| f != 1.0) {
-            return Err(format!(
-                "objects.{}.material.diffuse_f90: not supported (POV-Ray's diffuse term is Lambertian); use phong",
-                o.name
+            out.push(Refusal::new(
+                format!("objects.{}.material.diffuse_f90", o.name),
+                "not supported (POV-Ray's diffuse term is Lambertian); use phong",
             ));
         }
         if m.specular2.is_some_and(|k| k > 0.0) && m.transmission > 0.0 {
-            return Err(format!(
-                "objects.{}.material.specular2: a second specular lobe on a transmitting material is not supported by POV-Ray; use phong",
-                o.name
+            out.push(Refusal::new(
+                format!("objects.{}.material.specular2", o.name),
+                "a second specular lobe on a transmitting material is not supported by POV-Ray; use phong",
             ));
         }
     }
-    Ok(())
+    out
 }
 
 /// The fade of a point light whose irradiance falls as 1/d^p: POV-Ray's
@@ -147,7 +152,10 @@ fn fade(p: f64) -> (f64, String) {
 
 /// The scene file POV-Ray renders.
 pub fn sdl(scene: &Scene) -> Result<String, String> {
-    check(scene)?;
+    // a variant may move a free field where POV-Ray cannot follow
+    if let Some(r) = refusals(scene).first() {
+        return Err(format!("{}: {}", r.field, r.why));
+    }
     let mut s = String::with_capacity(4096);
     let _ = writeln!(
         s,

@@ -10,6 +10,7 @@
 //! sampler seed are unused: POV-Ray is deterministic.
 
 use super::external::{session_dir, ExternalSession, OneShotBackend};
+use super::registry::Backend;
 use super::{pov_sdl, RenderSession, Renderer};
 use crate::error::{Error, Result};
 use crate::exec::discover;
@@ -17,6 +18,15 @@ use crate::exec::process::CommandSpec;
 use crate::scene::{ParamSpace, Scene};
 use std::path::{Path, PathBuf};
 use std::time::Duration;
+
+/// The registry's entry (`registry::ALL`).
+pub const BACKEND: Backend = Backend {
+    name: "povray",
+    arg: None,
+    about: "POV-Ray 3.7, one process per render",
+    build: |_, opts| Box::new(PovRay(opts)),
+    supports: pov_sdl::refusals,
+};
 
 /// Default per-render timeout: a render takes about a second, several
 /// when 64 share two cores.
@@ -41,11 +51,10 @@ impl Renderer for PovRay {
 
     fn session(
         &self,
-        base: &Scene,
+        _base: &Scene,
         _varying: &ParamSpace,
         jobs: usize,
     ) -> Result<Box<dyn RenderSession>> {
-        pov_sdl::check(base).map_err(|m| Error::Usage(format!("povray: {m}")))?;
         let program = discover::find("povray", &discover::apt_hint("povray"))?;
         let (cfg, dir) = session_dir(jobs, (RENDER_TIMEOUT, RENDER_TIMEOUT), &self.0)?;
         let version = version(&program);

@@ -1,24 +1,26 @@
 //! The font the figures' text is drawn with. plotters draws text through
 //! ab_glyph from a font registered by name; a font file is read once from
-//! the system (DejaVu Sans on Debian, package fonts-dejavu-core), from
-//! the `--font` flag or from `SCENEFIT_FONT`, rather than linking
-//! fontconfig or shipping a font in the binary.
+//! the system (DejaVu Sans on Debian, package fonts-dejavu-core) or from
+//! the file the caller names (the command line's `--font` or
+//! `SCENEFIT_FONT`, read in `cli::env`), rather than linking fontconfig or
+//! shipping a font in the binary.
 
 use crate::error::{Error, Result};
 use plotters::style::{register_font, FontStyle};
 use std::path::PathBuf;
 use std::sync::OnceLock;
 
-/// The font given on the command line (`--font`), ahead of `SCENEFIT_FONT`.
-static FLAG: OnceLock<PathBuf> = OnceLock::new();
+/// The font the caller named, and where it was named (for errors).
+static NAMED: OnceLock<(&'static str, PathBuf)> = OnceLock::new();
 
-/// Uses this font file for the figures, ahead of `SCENEFIT_FONT` and the
-/// system's fonts; call before the first figure (later calls are ignored).
-pub fn use_file(path: PathBuf) {
-    let _ = FLAG.set(path);
+/// Uses this font file for the figures, ahead of the system's fonts;
+/// `source` says where it was named (`--font`). Call before the first
+/// figure (later calls are ignored).
+pub fn use_file(source: &'static str, path: PathBuf) {
+    let _ = NAMED.set((source, path));
 }
 
-/// Where to look, in order, after `--font` and `SCENEFIT_FONT`.
+/// Where to look, in order, when the caller named no font.
 const CANDIDATES: &[&str] = &[
     "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf",
     "/usr/share/fonts/TTF/DejaVuSans.ttf",
@@ -40,13 +42,9 @@ pub fn ensure() -> Result<()> {
 }
 
 fn load() -> std::result::Result<(), String> {
-    // The flag, else the variable; a named font that cannot be read is an
-    // error rather than silently replaced by a system font.
-    let named = match FLAG.get() {
-        Some(p) => Some(("--font", p.clone())),
-        None => std::env::var_os("SCENEFIT_FONT").map(|p| ("SCENEFIT_FONT", PathBuf::from(p))),
-    };
-    if let Some((source, path)) = &named {
+    // A named font that cannot be read is an error rather than silently
+    // replaced by a system font.
+    if let Some((source, path)) = NAMED.get() {
         return register(path).ok_or_else(|| {
             format!(
                 "{source} {}: not a readable TrueType font; the report's figures need one",

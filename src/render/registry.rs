@@ -1,0 +1,182 @@
+//! The backends, as one list (`ALL`) like the diagnosis's effects: each
+//! entry names a backend, says in a line what it is, builds it from the
+//! caller's options and says what in a scene it cannot draw (`supports`).
+//! Choosing a backend by name, listing the names and refusing a scene
+//! before any renderer starts all go through this list; plug-ins
+//! (`cmd:`, `worker:`) are entries whose name is a prefix.
+
+use super::{phong, RenderOptions, RenderSession, Renderer};
+use crate::error::{Error, Result};
+use crate::scene::{ParamSpace, Scene};
+
+/// A scene field a backend cannot draw, and why.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Refusal {
+    /// The field's path in the scene, e.g. `objects.ball.material.fresnel`.
+    pub field: String,
+    /// Why, and what to use instead.
+    pub why: String,
+}
+
+impl Refusal {
+    pub fn new(field: impl Into<String>, why: impl Into<String>) -> Refusal {
+        Refusal {
+            field: field.into(),
+            why: why.into(),
+        }
+    }
+}
+
+/// One backend.
+pub struct Backend {
+    /// The name on the command line; for a plug-in, the prefix before its
+    /// command (`cmd:`).
+    pub name: &'static str,
+    /// For a plug-in, what follows the prefix (`TEMPLATE`); None for a
+    /// plain name.
+    pub arg: Option<&'static str>,
+    /// One line: what draws the image.
+    pub about: &'static str,
+    /// The backend, given what follows the prefix (empty for a plain name).
+    pub build: fn(&str, RenderOptions) -> Box<dyn Renderer>,
+    /// Every field of the scene it cannot draw, and why; empty if it draws
+    /// all of it.
+    pub supports: fn(&Scene) -> Vec<Refusal>,
+}
+
+impl Backend {
+    /// How the name is written in help and errors: `phong`, `cmd:TEMPLATE`.
+    pub fn usage(&self) -> String {
+        format!("{}{}", self.name, self.arg.unwrap_or(""))
+    }
+}
+
+/// The built-in tracer: draws every field (it is the model).
+const PHONG: Backend = Backend {
+    name: "phong",
+    arg: None,
+    about: "the built-in Whitted-style tracer (the model every other backend is matched to)",
+    build: |_, _| Box::new(phong::Phong),
+    supports: |_| Vec::new(),
+};
+
+/// Every backend, in the order help and errors list them.
+pub static ALL: &[Backend] = &[
+    PHONG,
+    super::povray::BACKEND,
+    super::blender::BACKEND,
+    super::mitsuba::BACKEND,
+    super::command::ONE_SHOT,
+    super::command::WORKER,
+];
+
+/// The entry `spec` names, and what follows its prefix (empty for a plain
+/// name). An unknown name is a usage error listing the known ones.
+pub fn find(spec: &str) -> Result<(&'static Backend, &str)> {
+    for b in ALL {
+        match b.arg {
+            None if spec == b.name => return Ok((b, "")),
+            Some(_) if spec.starts_with(b.name) => return Ok((b, &spec[b.name.len()..])),
+            _ => {}
+        }
+    }
+    let names: Vec<String> = ALL.iter().map(Backend::usage).collect();
+    let (last, rest) = names.split_last().expect("ALL is not empty");
+    Err(Error::Usage(format!(
+        "--renderer {spec}: unknown renderer; expected {} or {last}",
+        rest.join(", ")
+    )))
+}
+
+/// The backend named by `spec`, refusing, before its session starts, any
+/// scene with a field it cannot draw.
+pub fn build(spec: &str, opts: &RenderOptions) -> Result<Box<dyn Renderer>> {
+    let (entry, rest) = find(spec)?;
+    Ok(Box::new(Checked {
+        entry,
+        inner: (entry.build)(rest, opts.clone()),
+    }))
+}
+
+/// A backend behind its `supports` check.
+struct Checked {
+    entry: &'static Backend,
+    inner: Box<dyn Renderer>,
+}
+
+impl Renderer for Checked {
+    fn name(&self) -> String {
+        self.inner.name()
+    }
+
+    fn default_jobs(&self) -> usize {
+        self.inner.default_jobs()
+    }
+
+    fn session(
+        &self,
+        base: &Scene,
+        varying: &ParamSpace,
+        jobs: usize,
+    ) -> Result<Box<dyn RenderSession>> {
+        let refused = (self.entry.supports)(base);
+        if let Some(first) = refused.first() {
+            // one line: the first field in full, the others by name
+            let more: Vec<&str> = refused[1..].iter().map(|r| r.field.as_str()).collect();
+            let also = if more.is_empty() {
+                String::new()
+            } else {
+                format!(" (also refused: {})", more.join(", "))
+            };
+            return Err(Error::Usage(format!(
+                "{}: {}: {}{also}",
+                self.inner.name(),
+                first.field,
+                first.why
+            )));
+        }
+        self.inner.session(base, varying, jobs)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_resolve_to_their_entry_and_unknown_names_list_every_entry() {
+        for b in ALL {
+            let spec = format!("{}{}", b.name, if b.arg.is_some() { "prog" } else { "" });
+            let (found, rest) = find(&spec).unwrap();
+            assert_eq!(found.name, b.name);
+            assert_eq!(rest, if b.arg.is_some() { "prog" } else { "" });
+        }
+        let e = find("povrey").err().unwrap().to_string();
+        for b in ALL {
+            assert!(e.contains(&b.usage()), "{e}");
+        }
+        assert!(e.contains("--renderer povrey"), "{e}");
+    }
+
+    #[test]
+    fn a_refused_field_stops_the_session_naming_every_refused_field() {
+        let mut scene = crate::scene::test_scene::ball(r#""color": [0.5, 0.5, 0.5]"#, "");
+        scene.objects[0].material.diffuse_f90 = Some(0.4);
+        scene.objects[0].material.fresnel = Some(0.1);
+        let r = build("povray", &RenderOptions::default()).unwrap();
+        let e = r
+            .session(&scene, &ParamSpace::default(), 1)
+            .err()
+            .unwrap()
+            .to_string();
+        assert!(e.starts_with("povray: objects."), "{e}");
+        assert!(
+            e.contains("material.fresnel") && e.contains("material.diffuse_f90"),
+            "{e}"
+        );
+        assert!(build("phong", &RenderOptions::default())
+            .unwrap()
+            .session(&scene, &ParamSpace::default(), 1)
+            .is_ok());
+    }
+}

@@ -1,0 +1,273 @@
+"""A scenefit-scene/1 scene as a renderer-neutral description, shared by the
+Blender worker (blender_scripts/worker.py) and the Mitsuba worker
+(workers/mitsuba_worker.py), so that a shape, a light or a material field is
+read and checked once; each worker keeps only what its renderer builds from
+the description. scenefit writes this module beside each worker, next to
+jsonlines.py (the Blender worker also finds it in ../workers).
+
+``describe(scene)`` returns plain Python values, in the scene's own frame
+(y up, metres), the numbers as the scene gives them (no renderer's
+conversion applied; directions and normals not normalised, so that each
+worker keeps its own arithmetic):
+
+- ``width``, ``height``, ``samples``, ``indirect``, ``ambient``;
+- ``camera``: ``type``, ``position``, ``look_at``, ``up`` and ``fov_y``
+  (perspective, degrees) or ``height`` (orthographic);
+- ``lights``: ``name``, ``type`` (point or directional), ``color``,
+  ``intensity``, ``radius``, and ``position`` and ``power`` (the falloff
+  exponent: 1/d^power) or ``direction``;
+- ``objects``: ``name``, ``shape`` (``type`` and its fields in world space:
+  sphere ``center``, ``radius``; plane ``point``, ``normal``; quad
+  ``corner``, ``edge_u``, ``edge_v``; box ``min``, ``max``) and
+  ``material``: the project's convention values (docs/renderers.md, "One
+  material convention") and its ``kind``: lambertian (diffuse only), phong
+  (the built-in tracer's lobes) or principled (transmitting: glass).
+"""
+
+import math
+
+import jsonlines
+
+
+class SceneError(jsonlines.RequestError):
+    """A scene a worker cannot build (answered as ok:false)."""
+
+
+# ---------------------------------------------------------------- checked values
+def num(v, where):
+    if isinstance(v, bool):
+        raise SceneError("%s: expected a number, got %r" % (where, v))
+    try:
+        x = float(v)
+    except (TypeError, ValueError):
+        raise SceneError("%s: expected a number, got %r" % (where, v))
+    if not math.isfinite(x):
+        raise SceneError("%s: not finite: %r" % (where, v))
+    return x
+
+
+def vec3(v, where):
+    if not isinstance(v, (list, tuple)) or len(v) != 3 or any(isinstance(x, bool) for x in v):
+        raise SceneError("%s: expected a list of 3 numbers, got %r" % (where, v))
+    try:
+        out = tuple(float(x) for x in v)
+    except (TypeError, ValueError):
+        raise SceneError("%s: expected a list of 3 numbers, got %r" % (where, v))
+    if not all(math.isfinite(x) for x in out):
+        raise SceneError("%s: not finite: %r" % (where, v))
+    return out
+
+
+def obj(d, key, where, required=True):
+    """The object d[key] ({} when absent and not required)."""
+    v = d.get(key)
+    if v is None and not required:
+        return {}
+    if not isinstance(v, dict):
+        raise SceneError("%s.%s: missing or not an object" % (where, key))
+    return v
+
+
+def count(d, key, where, default):
+    v = d.get(key, default)
+    if not isinstance(v, int) or isinstance(v, bool) or v <= 0:
+        raise SceneError("%s.%s: must be a positive integer, got %r" % (where, key, v))
+    return v
+
+
+def named_entries(scene, key, singular):
+    """(name, "key.name", entry) for each entry of the scene's list `key`;
+    an entry without a name is called singular + its index."""
+    entries = scene.get(key, []) or []
+    if not isinstance(entries, list):
+        raise SceneError("scene.%s: expected a list" % key)
+    for i, entry in enumerate(entries):
+        if not isinstance(entry, dict):
+            raise SceneError("%s[%d]: expected an object" % (key, i))
+        name = str(entry.get("name", "%s%d" % (singular, i)))
+        yield name, "%s.%s" % (key, name), entry
+
+
+# ---------------------------------------------------------------- small vector math
+def add(a, b):
+    return (a[0] + b[0], a[1] + b[1], a[2] + b[2])
+
+
+def sub(a, b):
+    return (a[0] - b[0], a[1] - b[1], a[2] - b[2])
+
+
+def mul(a, s):
+    return (a[0] * s, a[1] * s, a[2] * s)
+
+
+def dot(a, b):
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+
+
+def cross(a, b):
+    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
+
+
+def norm(a):
+    return math.sqrt(dot(a, a))
+
+
+def normalize(a, where):
+    n = norm(a)
+    if n == 0.0:
+        raise SceneError("%s: zero-length vector" % where)
+    return mul(a, 1.0 / n)
+
+
+# ---------------------------------------------------------------- the parts
+def roughness(n):
+    """The microfacet roughness both workers give a Blinn-Phong exponent n
+    (docs/renderers.md, "Shininess, roughness, specular level")."""
+    return (2.0 / (n + 2.0)) ** 0.25
+
+
+def material(m, where):
+    """The convention values of a material, checked."""
+    if m is None:
+        m = {}
+    if not isinstance(m, dict):
+        raise SceneError("%s: expected an object" % where)
+    if "color" not in m:
+        raise SceneError("%s.color: missing" % where)
+    color = vec3(m["color"], where + ".color")
+    kd = num(m.get("diffuse", 1.0), where + ".diffuse")
+    v = {"color": color, "kd": kd, "albedo": (kd * color[0], kd * color[1], kd * color[2])}
+    for key, field, default in (("ks", "specular", 0.0), ("n", "shininess", 10.0),
+                                ("kr", "reflection", 0.0), ("kt", "transmission", 0.0),
+                                ("ior", "ior", 1.5), ("ks2", "specular2", 0.0),
+                                ("f0", "fresnel", 1.0)):
+        v[key] = num(m.get(field, default), "%s.%s" % (where, field))
+    v["n2"] = num(m.get("shininess2", v["n"]), where + ".shininess2")
+    if v["kt"] != 0.0:
+        v["kind"] = "principled"
+    elif v["ks"] == 0.0 and v["ks2"] == 0.0 and v["kr"] == 0.0:
+        v["kind"] = "lambertian"
+        return v
+    else:
+        v["kind"] = "phong"
+    if v["kind"] == "phong" and (v["n"] < 0.0 or v["n2"] < 0.0):
+        raise SceneError("%s.shininess: must be >= 0, got %r" % (where, min(v["n"], v["n2"])))
+    if v["kind"] == "phong" and not 0.0 < v["f0"] <= 1.0:
+        raise SceneError("%s.fresnel: must be in (0, 1], got %r" % (where, v["f0"]))
+    if v["kind"] == "principled" and v["n"] < 0.0:
+        raise SceneError("%s.shininess: must be >= 0, got %r" % (where, v["n"]))
+    if v["kind"] == "principled" and v["ior"] <= 0.0:
+        raise SceneError("%s.ior: must be > 0, got %r" % (where, v["ior"]))
+    return v
+
+
+def falloff_power(L, where):
+    """A point light's falloff exponent: `falloff_power`, else 2
+    (inverse_square) or 0 (none)."""
+    falloff = L.get("falloff", "inverse_square")
+    if falloff not in ("none", "inverse_square"):
+        raise SceneError("%s.falloff: unknown %r (inverse_square or none)" % (where, falloff))
+    if "falloff_power" in L:
+        return num(L["falloff_power"], where + ".falloff_power")
+    return 0.0 if falloff == "none" else 2.0
+
+
+def light(name, where, L):
+    out = {"name": name, "type": L.get("type", "point"),
+           "color": vec3(L.get("color", [1, 1, 1]), where + ".color"),
+           "intensity": num(L.get("intensity", 1.0), where + ".intensity"),
+           "radius": num(L.get("radius", 0.0), where + ".radius")}
+    if out["intensity"] < 0.0:
+        raise SceneError("%s.intensity: must be >= 0" % where)
+    if out["radius"] < 0.0:
+        raise SceneError("%s.radius: must be >= 0" % where)
+    if out["type"] == "point":
+        out["position"] = vec3(L.get("position"), where + ".position")
+        out["power"] = falloff_power(L, where)
+    elif out["type"] == "directional":
+        out["direction"] = vec3(L.get("direction"), where + ".direction")
+        normalize(out["direction"], where + ".direction")
+        if out["radius"] >= math.pi / 2:
+            raise SceneError("%s.radius: must be below pi/2 for a directional light" % where)
+    else:
+        raise SceneError("%s.type: unknown %r (point or directional)" % (where, out["type"]))
+    return out
+
+
+# The fields of each shape: (name, kind) with kind "point" or "number".
+SHAPES = {
+    "sphere": (("center", "point"), ("radius", "number")),
+    "plane": (("point", "point"), ("normal", "point")),
+    "quad": (("corner", "point"), ("edge_u", "point"), ("edge_v", "point")),
+    "box": (("min", "point"), ("max", "point")),
+}
+
+
+def shape(sh, where):
+    """A shape's type and fields, checked: the one place a new shape's
+    fields are read."""
+    stype = sh.get("type")
+    if stype not in SHAPES:
+        raise SceneError("%s.type: unknown %r (%s)" % (where, stype, ", ".join(SHAPES)))
+    out = {"type": stype}
+    for field, kind in SHAPES[stype]:
+        read = vec3 if kind == "point" else num
+        out[field] = read(sh.get(field), "%s.%s" % (where, field))
+    if stype == "sphere" and out["radius"] <= 0.0:
+        raise SceneError("%s.radius: must be > 0" % where)
+    if stype == "plane":
+        normalize(out["normal"], where + ".normal")
+    if stype == "quad" and norm(cross(out["edge_u"], out["edge_v"])) < 1e-12:
+        raise SceneError("%s: edge_u and edge_v are parallel or zero" % where)
+    if stype == "box" and not all(out["max"][k] > out["min"][k] for k in range(3)):
+        raise SceneError("%s: max must exceed min on every axis" % where)
+    return out
+
+
+def camera(cam, where):
+    out = {"type": cam.get("type", "perspective"),
+           "position": vec3(cam.get("position"), where + ".position"),
+           "look_at": vec3(cam.get("look_at"), where + ".look_at"),
+           "up": vec3(cam.get("up", [0, 1, 0]), where + ".up")}
+    if norm(sub(out["look_at"], out["position"])) == 0.0:
+        raise SceneError("%s: position equals look_at" % where)
+    if out["type"] == "perspective":
+        out["fov_y"] = num(cam.get("fov_y_deg", 40.0), where + ".fov_y_deg")
+        if not 0.0 < out["fov_y"] < 180.0:
+            raise SceneError("%s.fov_y_deg: must be in (0, 180), got %r" % (where, out["fov_y"]))
+    elif out["type"] == "orthographic":
+        out["height"] = num(cam.get("height", 1.0), where + ".height")
+        if out["height"] <= 0.0:
+            raise SceneError("%s.height: must be > 0, got %r" % (where, out["height"]))
+    else:
+        raise SceneError("%s.type: unknown %r (perspective or orthographic)" % (where, out["type"]))
+    return out
+
+
+def describe(scene):
+    """The scene JSON, checked, as the neutral description of the module
+    docstring."""
+    if not isinstance(scene, dict):
+        raise SceneError("scene: expected an object")
+    img = obj(scene, "image", "scene")
+    w, h = count(img, "width", "image", None), count(img, "height", "image", None)
+    if w > 65536 or h > 65536:
+        raise SceneError("image: size %dx%d out of range" % (w, h))
+    render = obj(scene, "render", "scene", required=False)
+    indirect = render.get("indirect", True)
+    if not isinstance(indirect, bool):
+        raise SceneError("render.indirect: must be true or false, got %r" % (indirect,))
+    objects = []
+    for name, where, o in named_entries(scene, "objects", "object"):
+        objects.append({"name": name,
+                        "shape": shape(obj(o, "shape", where), where + ".shape"),
+                        "material": material(o.get("material"), where + ".material")})
+    return {
+        "width": w, "height": h, "indirect": indirect,
+        "samples": count(render, "samples", "render", 16),
+        "camera": camera(obj(scene, "camera", "scene"), "camera"),
+        "ambient": vec3(scene.get("ambient", [0, 0, 0]), "scene.ambient"),
+        "lights": [light(n, where, L) for n, where, L in named_entries(scene, "lights", "light")],
+        "objects": objects,
+    }
