@@ -1,7 +1,7 @@
 //! Renderers: the `Renderer` trait every backend implements, and the choice
 //! of backend from a name (`phong`, `povray`, `blender`, `mitsuba`,
-//! `cmd:TEMPLATE`, `worker:COMMAND`). Nothing outside this module knows
-//! which backend runs.
+//! `cmd:TEMPLATE`, `worker:COMMAND`; `registry.rs`). Nothing outside this
+//! module knows which backend runs.
 
 pub mod camera_effects;
 pub mod phong;
@@ -15,6 +15,7 @@ pub mod near_lights;
 pub mod pbr_fields;
 pub mod pov_sdl;
 pub mod povray;
+mod registry;
 
 use crate::error::{Error, Result};
 use crate::exec::{ExecOverrides, Executor};
@@ -24,6 +25,7 @@ use std::time::Duration;
 
 pub use crate::exec::{RenderFailure, RenderResult};
 pub use crate::raster::Image;
+pub use registry::{from_spec, from_spec_with};
 
 /// A backend. `session` prepares it to render many variants of one scene.
 pub trait Renderer: Send + Sync {
@@ -88,35 +90,6 @@ impl RenderOptions {
             executor: self.executor.clone(),
             slurm_ledger: self.slurm_ledger.clone(),
         }
-    }
-}
-
-/// The backend named by `spec` (see the module doc), followed by the
-/// camera's image-space effects (`camera_effects.rs`), with the defaults
-/// and the environment's settings.
-pub fn from_spec(spec: &str) -> Result<Box<dyn Renderer>> {
-    from_spec_with(spec, &RenderOptions::default())
-}
-
-/// `from_spec` with `opts` over the environment and the defaults.
-pub fn from_spec_with(spec: &str, opts: &RenderOptions) -> Result<Box<dyn Renderer>> {
-    let drawn = near_lights::WithNearLights(backend(spec, opts)?);
-    Ok(Box::new(camera_effects::WithCameraEffects(Box::new(drawn))))
-}
-
-/// The bare backend named by `spec`.
-fn backend(spec: &str, opts: &RenderOptions) -> Result<Box<dyn Renderer>> {
-    let o = opts.clone();
-    match spec {
-        "phong" => Ok(Box::new(phong::Phong)),
-        "povray" => Ok(Box::new(povray::PovRay(o))),
-        "blender" => Ok(Box::new(blender::Blender(o))),
-        "mitsuba" => Ok(Box::new(mitsuba::Mitsuba(o))),
-        s if s.starts_with("cmd:") => Ok(Box::new(command::Command::one_shot(&s["cmd:".len()..], o))),
-        s if s.starts_with("worker:") => Ok(Box::new(command::Command::worker(&s["worker:".len()..], o))),
-        other => Err(Error::Usage(format!(
-            "--renderer {other}: unknown renderer; expected phong, povray, blender, mitsuba, cmd:TEMPLATE or worker:COMMAND"
-        ))),
     }
 }
 
