@@ -3,6 +3,7 @@
 
 use crate::diagnose::{self, DiagnoseConfig, Inputs};
 use crate::error::{Error, Result};
+use crate::rundir::SHOTS;
 use clap::Args;
 use std::path::PathBuf;
 
@@ -61,9 +62,9 @@ pub fn run(a: DiagnoseArgs) -> Result<()> {
     }
     let set = diagnose::set::SetInputs::from_fit_dir(&a.fit_dir)?;
     if set.is_some() && (a.target.is_some() || a.mask.is_some()) {
-        return Err(Error::Usage(
-            "--target/--mask: the fit directory holds a set of photographs; each one's target and mask come from its shots.json".into(),
-        ));
+        return Err(Error::Usage(format!(
+            "--target/--mask: the fit directory holds a set of photographs; each one's target and mask come from its {SHOTS}"
+        )));
     }
     let mut config = DiagnoseConfig {
         renderer: a.renderer,

@@ -21,10 +21,10 @@ pub struct RenderArgs {
     #[arg(long = "set", value_name = "PARAM=JSON")]
     set: Vec<Override>,
     /// Image width (overrides the scene's).
-    #[arg(long, allow_hyphen_values = true, value_parser = super::pixels)]
+    #[arg(long, allow_hyphen_values = true, value_parser = super::values::pixels)]
     width: Option<u32>,
     /// Image height (overrides the scene's).
-    #[arg(long, allow_hyphen_values = true, value_parser = super::pixels)]
+    #[arg(long, allow_hyphen_values = true, value_parser = super::values::pixels)]
     height: Option<u32>,
     /// Sampler seed for sampling renderers.
     #[arg(long, default_value_t = 0)]

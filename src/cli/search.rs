@@ -141,10 +141,10 @@ fn arg<K: Kind>(name: &str, help: &str) -> Arg {
 fn args<K: Kind>() -> Vec<Arg> {
     let mut v = vec![
         arg::<K>(POPULATION, "individuals per generation")
-            .value_parser(super::positive_count)
+            .value_parser(super::values::positive_count)
             .default_value(K::POPULATION.to_string()),
         arg::<K>(GENERATIONS, "generations over all phases")
-            .value_parser(super::positive_count)
+            .value_parser(super::values::positive_count)
             .default_value(K::GENERATIONS.to_string()),
         arg::<K>(F, "differential weight F (rand1bin)")
             .value_parser(value_parser!(f64))
@@ -165,7 +165,7 @@ fn args<K: Kind>() -> Vec<Arg> {
         .value_parser(value_parser!(u64))
         .default_value("1"),
         arg::<K>(JOBS, "renders at once (default: the renderer's choice)")
-            .value_parser(super::positive_count),
+            .value_parser(super::values::positive_count),
         arg::<K>(
             STAGNATION,
             "stop a phase after this many generations without improvement",

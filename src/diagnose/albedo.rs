@@ -16,8 +16,9 @@
 //! (the better of the two kept). Its parameters for the criterion are the
 //! values solved, ln N each.
 
+use super::inputs::Params;
 use super::refit::{Model, Refine, Refits};
-use super::set::{shots_of, SetModel, SetRefits};
+use super::set_refit::{shots_of, SetModel, SetRefits};
 use super::Candidate;
 use crate::error::{Error, Result};
 use crate::fit::set::shots::Shot;
@@ -28,9 +29,6 @@ use crate::render::render_one;
 use crate::scene::albedo_map::{self, AlbedoMap};
 use crate::scene::{Response, Scene};
 use std::path::{Path, PathBuf};
-
-/// The effect's name in diagnosis.json.
-pub const NAME: &str = "albedo_map";
 
 /// Photographs with evidence a value needs.
 const MIN_PHOTOGRAPHS: usize = 2;
@@ -287,9 +285,10 @@ fn solve_one(
     Ok(Some((with_map(scene, Some(path)), solved.count)))
 }
 
-/// The candidate `albedo_map` on one photograph: solved, the others
-/// refitted, solved again; None when nothing could be solved.
+/// The candidate `albedo_map` (named `effect`) on one photograph: solved,
+/// the others refitted, solved again; None when nothing could be solved.
 pub fn candidate(
+    effect: &str,
     fits: &mut Refits,
     model: &Model,
     round: usize,
@@ -317,7 +316,7 @@ pub fn candidate(
         }
     }
     let refit = "closed form, then warm";
-    let c = Candidate::scored(NAME, round, fits.inputs, model, &fitted, count, refit);
+    let c = Candidate::scored(effect, round, fits.inputs, model, &fitted, count, refit);
     Ok(Some((c, fitted)))
 }
 
@@ -326,7 +325,7 @@ pub fn candidate(
 fn solve_set(
     fits: &mut SetRefits,
     scene: &Scene,
-    own: &[super::set::Params],
+    own: &[Params],
     path: &Path,
 ) -> Result<Option<(Scene, usize)>> {
     let zero = zero_map(scene, fits.out)?;

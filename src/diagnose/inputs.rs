@@ -1,13 +1,15 @@
 //! What a diagnosis starts from: the fitted scene of a fit directory, its
 //! target, and the mask (without the target's saturated pixels, as in the
-//! fit).
+//! fit); for a set fit, the shared model, the photographs and each one's
+//! own fitted values.
 
-use crate::error::Result;
+use crate::error::{Error, Result};
+use crate::fit::set::shots::Shot;
 use crate::fit::{FitResult, FitTarget};
 use crate::metric::Mask;
 use crate::raster::Encoding;
 use crate::raster::Image;
-use crate::rundir::{RunDir, FITTED_SCENE, MASK};
+use crate::rundir::{RunDir, FITTED_SCENE, MASK, SHOTS};
 use crate::scene::Scene;
 use std::path::{Path, PathBuf};
 
@@ -59,4 +61,49 @@ fn fit_target(dir: &Path) -> Result<(PathBuf, Option<Encoding>)> {
         run.find_target(result.target.as_deref())?,
         result.target_encoding,
     ))
+}
+
+/// A photograph's own values: parameter name to value.
+pub type Params = serde_json::Map<String, serde_json::Value>;
+
+/// A set fit's outputs, as a diagnosis starts from them.
+pub struct SetInputs {
+    /// The shared model.
+    pub scene: Scene,
+    pub shots: Vec<Shot>,
+    /// Each photograph's own fitted values.
+    pub own: Vec<Params>,
+}
+
+impl SetInputs {
+    /// The set fit in `dir`, or None when `dir` holds a fit of one photograph.
+    pub fn from_fit_dir(dir: &Path) -> Result<Option<SetInputs>> {
+        if !dir.join(crate::rundir::RESULT).is_file() {
+            return Ok(None); // the one-photograph path says what is missing
+        }
+        let run = RunDir::existing(dir)?;
+        let result = FitResult::load(&run)?;
+        let Some(results) = result.shots else {
+            return Ok(None);
+        };
+        let scene = crate::scene::load(&dir.join(FITTED_SCENE))?;
+        let (shots, _) = crate::fit::set::shots::load(&dir.join(SHOTS), &scene)?;
+        let own = shots
+            .iter()
+            .map(|s| {
+                results
+                    .iter()
+                    .find(|r| r.name == s.name)
+                    .map(|r| r.params.clone())
+                    .ok_or_else(|| {
+                        Error::invalid(
+                            run.file(crate::rundir::RESULT).display().to_string(),
+                            "shots",
+                            format!("expected a result for shot {}", s.name),
+                        )
+                    })
+            })
+            .collect::<Result<Vec<_>>>()?;
+        Ok(Some(SetInputs { scene, shots, own }))
+    }
 }

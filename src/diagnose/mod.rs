@@ -16,115 +16,39 @@
 //! model is polished (every parameter refined) before the next round.
 //! Rounds repeat until nothing is accepted; `unexplained` is reported when
 //! smooth structure remains in the residual. Inputs come from a fit
-//! directory (`inputs.rs`); the files written are named in `output.rs`.
+//! directory (`inputs.rs`); the files written are named in `rundir`.
 
 mod albedo;
 mod config;
+mod diagnosis;
 pub mod effects;
+pub mod features;
 mod held;
 mod inputs;
 mod lanes;
-pub mod output;
 pub mod photo;
 mod refit;
 pub mod report;
 pub mod residual;
 mod selection;
 pub mod set;
+mod set_refit;
 mod starts;
 
 pub use config::DiagnoseConfig;
+pub use diagnosis::{Candidate, Diagnosis, UNEXPLAINED};
 pub use inputs::Inputs;
 
 use crate::error::{Error, Result};
-use crate::metric::{deviation, Deviation};
+use crate::metric::deviation;
 use crate::render::{from_spec_with, render_one};
 use crate::scene::{ParamSpace, Scene};
 use effects::Effect;
 use refit::{Model, Refine, Refits, Search};
 use residual::Residual;
 use selection::samples;
-use serde::Serialize;
 use std::path::Path;
 use std::time::Instant;
-
-/// One effect tried in one round.
-#[derive(Clone, Debug, Serialize)]
-pub struct Candidate {
-    pub effect: String,
-    /// R² of the residual on the effect's feature maps.
-    pub evidence: f64,
-    /// The deviation after its refit (None: not applicable).
-    pub deviation_after: Option<Deviation>,
-    pub round: usize,
-    /// BIC after its refit minus BIC of the model it extends, with the
-    /// round's overdispersion (`selection.rs`).
-    pub delta_bic: Option<f64>,
-    /// ĉ of the round: how much less than independent samples its pixels
-    /// count for (1: independent).
-    pub overdispersion: Option<f64>,
-    /// Relative drop of the sum of absolute differences.
-    pub gain: Option<f64>,
-    pub added_params: usize,
-    pub accepted: bool,
-    /// Which refit counted: "warm" or "from scratch".
-    pub refit: String,
-}
-
-impl Candidate {
-    /// The candidate of an effect whose refit of `model` gave `fitted`
-    /// with `added` more free values: its deviation and gain on one
-    /// photograph; evidence and BIC change left for the round.
-    fn scored(
-        effect: &str,
-        round: usize,
-        inputs: &Inputs,
-        model: &Model,
-        fitted: &Model,
-        added: usize,
-        refit: &str,
-    ) -> Candidate {
-        Candidate {
-            effect: effect.to_string(),
-            evidence: 0.0,
-            deviation_after: Some(deviation(
-                &inputs.target,
-                &fitted.image,
-                inputs.mask.as_ref(),
-            )),
-            round,
-            delta_bic: None,
-            overdispersion: None,
-            gain: Some(1.0 - fitted.sad / model.sad.max(1e-9)),
-            added_params: added,
-            accepted: false,
-            refit: refit.into(),
-        }
-    }
-}
-
-/// diagnosis.json.
-#[derive(Clone, Debug, Serialize)]
-pub struct Diagnosis {
-    pub deviation_before: Deviation,
-    pub deviation_after: Deviation,
-    pub candidates: Vec<Candidate>,
-    pub accepted: Vec<String>,
-    pub params_after: serde_json::Map<String, serde_json::Value>,
-    /// The deviation of the unchanged model refitted with the same budget.
-    pub deviation_refined: Deviation,
-    /// Smooth structure remains that no effect explained.
-    pub unexplained: bool,
-    pub renders: usize,
-    pub wall_seconds: f64,
-    /// Free entries held at the fit's values through the diagnosis
-    /// (shared geometry, `held.rs`); free again in improved_scene.json.
-    #[serde(skip_serializing_if = "Vec::is_empty")]
-    pub held: Vec<String>,
-}
-
-/// The name `accepted` gets when smooth structure remains.
-pub const UNEXPLAINED: &str = "unexplained";
 
 /// Runs the diagnosis, writing its files into `out`.
 pub fn run(inputs: &Inputs, out: &Path, config: &DiagnoseConfig) -> Result<Diagnosis> {
@@ -211,7 +135,7 @@ fn run_round(
         let found = if !effect.closed_form() {
             refitted.next().flatten()
         } else if effect.applies(&model.scene) {
-            albedo::candidate(fits, model, round, out)?
+            albedo::candidate(effect.name(), fits, model, round, out)?
         } else {
             None
         };

@@ -4,9 +4,10 @@
 //! never resumed, and its checkpoints would cost more than its renders).
 
 use super::selection::sad;
-use super::{DiagnoseConfig, Inputs};
+use super::{Candidate, DiagnoseConfig, Inputs};
 use crate::error::Result;
 use crate::fit::{self, FitConfig, FitTarget};
+use crate::metric::deviation;
 use crate::optimize::DeConfig;
 use crate::raster::Image;
 use crate::render::Renderer;
@@ -236,5 +237,37 @@ impl super::lanes::Lanes for Refits<'_> {
 
     fn add_renders(&mut self, n: usize) {
         self.renders += n;
+    }
+}
+
+impl Candidate {
+    /// The candidate of an effect whose refit of `model` gave `fitted`
+    /// with `added` more free values: its deviation and gain on one
+    /// photograph; evidence and BIC change left for the round.
+    pub(super) fn scored(
+        effect: &str,
+        round: usize,
+        inputs: &Inputs,
+        model: &Model,
+        fitted: &Model,
+        added: usize,
+        refit: &str,
+    ) -> Candidate {
+        Candidate {
+            effect: effect.to_string(),
+            evidence: 0.0,
+            deviation_after: Some(deviation(
+                &inputs.target,
+                &fitted.image,
+                inputs.mask.as_ref(),
+            )),
+            round,
+            delta_bic: None,
+            overdispersion: None,
+            gain: Some(1.0 - fitted.sad / model.sad.max(1e-9)),
+            added_params: added,
+            accepted: false,
+            refit: refit.into(),
+        }
     }
 }

@@ -4,15 +4,16 @@
 //! brighter; blue, darker), the render after, and the HTML report; for a
 //! set of photographs, those of every photograph, in a grid.
 
-use super::output;
+use super::diagnosis::{Diagnosis, SetDiagnosis};
+use super::inputs::SetInputs;
 use super::residual::Residual;
-use super::set::{SetDiagnosis, SetInputs, SetModel};
-use super::Diagnosis;
+use super::set_refit::SetModel;
 use crate::error::{Error, Result};
 use crate::fsio::write_atomic;
 use crate::metric::Deviation;
 use crate::raster::{io as image_io, Image};
 use crate::report::html::{esc, href, Page};
+use crate::rundir;
 use crate::scene::Scene;
 use std::path::Path;
 
@@ -30,13 +31,13 @@ pub fn write(
     residuals: (&Residual, &Residual),
 ) -> Result<()> {
     let (before, after) = residuals;
-    write_atomic(&out.join(output::DIAGNOSIS_JSON), json(d)?.as_bytes())?;
-    write_atomic(&out.join(output::IMPROVED_SCENE), json(scene)?.as_bytes())?;
+    write_atomic(&out.join(rundir::DIAGNOSIS_JSON), json(d)?.as_bytes())?;
+    write_atomic(&out.join(rundir::IMPROVED_SCENE), json(scene)?.as_bytes())?;
     let scale = before.peak().max(after.peak()).max(1e-3);
-    image_io::write_image(&before.heatmap(scale), &out.join(output::RESIDUAL_BEFORE))?;
-    image_io::write_image(&after.heatmap(scale), &out.join(output::RESIDUAL_AFTER))?;
-    image_io::write_image(image, &out.join(output::RENDER_AFTER))?;
-    write_atomic(&out.join(output::REPORT_HTML), html(d, scale).as_bytes())
+    image_io::write_image(&before.heatmap(scale), &out.join(rundir::RESIDUAL_BEFORE))?;
+    image_io::write_image(&after.heatmap(scale), &out.join(rundir::RESIDUAL_AFTER))?;
+    image_io::write_image(image, &out.join(rundir::RENDER_AFTER))?;
+    write_atomic(&out.join(rundir::REPORT), html(d, scale).as_bytes())
 }
 
 /// Writes every file of the set diagnosis `d` into `out`: diagnosis.json,
@@ -50,9 +51,9 @@ pub fn write_set(
     residuals: (&[Residual], &[Residual]),
 ) -> Result<()> {
     let (before, after) = residuals;
-    write_atomic(&out.join(output::DIAGNOSIS_JSON), json(d)?.as_bytes())?;
+    write_atomic(&out.join(rundir::DIAGNOSIS_JSON), json(d)?.as_bytes())?;
     write_atomic(
-        &out.join(output::IMPROVED_SCENE),
+        &out.join(rundir::IMPROVED_SCENE),
         json(&model.scene)?.as_bytes(),
     )?;
     let scale = before
@@ -64,13 +65,13 @@ pub fn write_set(
         let name = &s.name;
         image_io::write_image(
             &before[i].heatmap(scale),
-            &out.join(output::shot_residual_before(name)),
+            &out.join(rundir::shot_residual_before(name)),
         )?;
         image_io::write_image(
             &after[i].heatmap(scale),
-            &out.join(output::shot_residual_after(name)),
+            &out.join(rundir::shot_residual_after(name)),
         )?;
-        image_io::write_image(&model.images[i], &out.join(output::shot_render_after(name)))?;
+        image_io::write_image(&model.images[i], &out.join(rundir::shot_render_after(name)))?;
     }
     let mut page = Page::new("scenefit diagnosis of a set of photographs");
     summary(&mut page, &d.diagnosis);
@@ -91,15 +92,15 @@ pub fn write_set(
             esc(&s.name),
             s.deviation_before.average,
             s.deviation_after.average,
-            img(output::shot_residual_before(&s.name)),
-            img(output::shot_residual_after(&s.name)),
-            img(output::shot_render_after(&s.name)),
+            img(rundir::shot_residual_before(&s.name)),
+            img(rundir::shot_residual_after(&s.name)),
+            img(rundir::shot_render_after(&s.name)),
         ));
     }
     grid.push_str("</table>");
     page.raw(&grid);
     candidates(&mut page, &d.diagnosis);
-    write_atomic(&out.join(output::REPORT_HTML), page.finish().as_bytes())
+    write_atomic(&out.join(rundir::REPORT), page.finish().as_bytes())
 }
 
 fn dev_row(name: &str, v: &Deviation) -> Vec<String> {
@@ -114,8 +115,8 @@ fn html(d: &Diagnosis, scale: f64) -> String {
     page.p(&format!(
         "Red: target brighter; blue: darker; full colour = {scale:.4} linear."
     ));
-    page.figure_enlarged(output::RESIDUAL_BEFORE, "before", 384);
-    page.figure_enlarged(output::RESIDUAL_AFTER, "after", 384);
+    page.figure_enlarged(rundir::RESIDUAL_BEFORE, "before", 384);
+    page.figure_enlarged(rundir::RESIDUAL_AFTER, "after", 384);
     candidates(&mut page, d);
     page.finish()
 }

@@ -21,6 +21,7 @@ pub mod pool;
 pub mod process;
 pub mod result;
 pub mod slurm;
+pub mod slurm_cancel;
 pub mod stats;
 pub mod tail;
 pub mod watchdog;

@@ -166,7 +166,7 @@ pub fn serve() -> i32 {
     }
     // the srun clients are dead now; their remote tasks may not be
     let prefixes: Vec<String> = slurm.into_iter().collect();
-    super::slurm::cancel_prefixes(&prefixes);
+    super::slurm_cancel::cancel_prefixes(&prefixes);
     for d in dirs {
         let _ = std::fs::remove_dir_all(d);
     }

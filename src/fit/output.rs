@@ -41,7 +41,16 @@ pub struct FitResult {
     /// A set of photographs (`fit --shots`): each one's own parameters and
     /// deviation; `params` then holds the shared ones.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub shots: Option<Vec<super::set::ShotResult>>,
+    pub shots: Option<Vec<ShotResult>>,
+}
+
+/// One photograph's part of result.json.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct ShotResult {
+    pub name: String,
+    /// This photograph's own parameters.
+    pub params: serde_json::Map<String, serde_json::Value>,
+    pub deviation: Deviation,
 }
 
 impl FitResult {

@@ -3,12 +3,9 @@
 //! strategy needs only each point's fitness; a local one (a Gauss–Newton
 //! step from finite differences) also needs its residual vector, and says
 //! so in its request, so the executor computes residuals only when asked.
-//!
-//! [`Searcher`] holds any strategy as one serialisable value, so that a
-//! checkpoint stores whichever one a run uses.
+//! `searcher.rs` holds any strategy as one value.
 
-use super::{De, DeConfig, Hybrid, Identifiability, Progress, Strategy};
-use serde::{Deserialize, Serialize};
+use super::{De, Progress};
 
 /// What a search wants evaluated next.
 #[derive(Clone, Debug, PartialEq)]
@@ -97,124 +94,5 @@ impl Search for De {
 
     fn population(&self) -> Option<(&[Vec<f64>], &[f64])> {
         Some((De::population(self), De::fitness(self)))
-    }
-}
-
-/// Any strategy, as one value a checkpoint can hold.
-///
-/// Externally tagged (`{"de": {...}}`), not internally: an internal tag
-/// makes serde buffer the value, and the buffer cannot hold the 128-bit
-/// integers the random generator's state contains.
-#[derive(Clone, Debug, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-// A run holds one searcher, so the variants' size difference costs nothing.
-#[allow(clippy::large_enum_variant)]
-pub enum Searcher {
-    De(De),
-    Hybrid(Hybrid),
-}
-
-/// Where a search starts.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Start<'a> {
-    /// Uniformly in the cube ([`De::new`]).
-    Uniform,
-    /// Around a known point, per-coordinate spread `radius` ([`De::around`]).
-    Around { center: &'a [f64], radius: f64 },
-    /// Around a known point, a spread per coordinate ([`De::around_each`]).
-    AroundEach { center: &'a [f64], radii: &'a [f64] },
-}
-
-impl Searcher {
-    /// The search `config.strategy` names: a [`De`] for the DE schemes, a
-    /// [`Hybrid`] (SHADE global phase) for [`Strategy::Hybrid`]. Never
-    /// panics: the config is sanitised as [`De::new`] does.
-    pub fn new(dim: usize, config: &DeConfig, start: Start) -> Searcher {
-        let global = match start {
-            Start::Uniform => De::new(dim, config.clone()),
-            Start::Around { center, radius } => De::around(dim, config.clone(), center, radius),
-            Start::AroundEach { center, radii } => {
-                De::around_each(dim, config.clone(), center, radii)
-            }
-        };
-        match config.strategy {
-            Strategy::Hybrid => Searcher::Hybrid(Hybrid::new(global, config)),
-            _ => Searcher::De(global),
-        }
-    }
-
-    /// Standard errors and correlations at the best point in unit
-    /// coordinates, when the strategy estimates them (the hybrid, once its
-    /// local phase has run).
-    pub fn identifiability(&self) -> Option<Identifiability> {
-        match self {
-            Searcher::De(_) => None,
-            Searcher::Hybrid(h) => h.identifiability(),
-        }
-    }
-
-    /// Makes a hybrid search end once it has settled ([`Hybrid::settle`]);
-    /// a DE search is left as it is.
-    pub fn settle(&mut self) {
-        if let Searcher::Hybrid(h) = self {
-            h.settle();
-        }
-    }
-
-    /// Declares periodic coordinates for a hybrid search
-    /// ([`Hybrid::set_periods`]); a DE search is left as it is.
-    pub fn set_periods(&mut self, periods: Vec<f64>) {
-        if let Searcher::Hybrid(h) = self {
-            h.set_periods(periods);
-        }
-    }
-
-    /// The strategy this search runs.
-    pub fn strategy(&self) -> Strategy {
-        match self {
-            Searcher::De(d) => d.config().strategy,
-            Searcher::Hybrid(_) => Strategy::Hybrid,
-        }
-    }
-
-    fn inner(&self) -> &dyn Search {
-        match self {
-            Searcher::De(d) => d,
-            Searcher::Hybrid(h) => h,
-        }
-    }
-
-    fn inner_mut(&mut self) -> &mut dyn Search {
-        match self {
-            Searcher::De(d) => d,
-            Searcher::Hybrid(h) => h,
-        }
-    }
-}
-
-impl Search for Searcher {
-    fn ask(&mut self) -> Request {
-        self.inner_mut().ask()
-    }
-    fn tell(&mut self, evaluations: &[Evaluation]) {
-        self.inner_mut().tell(evaluations)
-    }
-    fn best(&self) -> (&[f64], f64) {
-        self.inner().best()
-    }
-    fn generation(&self) -> usize {
-        self.inner().generation()
-    }
-    fn evaluations(&self) -> usize {
-        self.inner().evaluations()
-    }
-    fn progress(&self) -> &Progress {
-        self.inner().progress()
-    }
-    fn converged(&self) -> bool {
-        self.inner().converged()
-    }
-    fn population(&self) -> Option<(&[Vec<f64>], &[f64])> {
-        self.inner().population()
     }
 }

@@ -19,6 +19,7 @@
 //! bounds and only its start is seeded.
 
 use crate::error::{Error, Result};
+use crate::rundir::{INPUT_SCENE, STAGE2};
 use crate::scene::color::rgb_to_hsv;
 use crate::scene::{Bound, ColorSpace, Field, Scene, Value};
 use serde::{Deserialize, Serialize};
@@ -93,7 +94,8 @@ pub fn narrow(fitted: &Scene, window: f64, keep: &[String]) -> Result<(Scene, Ve
     // The narrowed scene must still be a valid scene (it is written as
     // stage2/input_scene.json and read back by `fit`).
     let json = serde_json::to_value(&scene).map_err(|e| Error::Run(e.to_string()))?;
-    let scene = crate::scene::load::from_value(json, "stage2/input_scene.json")?;
+    let name = format!("{STAGE2}/{INPUT_SCENE}");
+    let scene = crate::scene::load::from_value(json, &name)?;
     Ok((scene, report))
 }
 

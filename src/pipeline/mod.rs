@@ -206,7 +206,7 @@ pub fn run(
     let stage2 = stage2_summary(&r2, wall2, &stage2_config, config);
 
     let comparison = Comparison {
-        stage1: summary(&r1, wall1, &stage1_config, "stage1"),
+        stage1: summary(&r1, wall1, &stage1_config, STAGE1),
         stage2,
         handover: handover_summary(
             config,

@@ -28,6 +28,7 @@
 //! `best_gNNNN.bmp` per iteration, and at the end `fitted_scene.json`,
 //! `best.png` and `result.json` (with `method` and `iterations`).
 
+use super::trace::Trace;
 use crate::error::{Error, Result};
 use crate::fit::{self, render_seed, FitConfig, FitResult, FitTarget};
 use crate::metric::{deviation, Deviation};
@@ -36,7 +37,6 @@ use crate::raster::Image;
 use crate::render::{render_one, Renderer};
 use crate::rundir::{
     snapshot_name, Mode, RunDir, BEST, FITTED_SCENE, RESULT, SPACEMAP_CURRENT, SPACEMAP_STATE,
-    TRACE,
 };
 use crate::scene::{ParamSpace, Scene};
 use serde::{Deserialize, Serialize};
@@ -197,7 +197,7 @@ pub fn run(
         state.seconds = seconds_before + started.elapsed().as_secs_f64();
         state.stop_reason = stop_reason(&state, config);
         state.iterations.push(iteration.clone());
-        append_trace(dir, k, state.fine_renders, state.seconds, &state.current)?;
+        Trace::append(dir)?.line(k, state.fine_renders, state.seconds, &state.current)?;
         dir.write_image(&snapshot_name(k), &fine_now)?;
         save(dir, &state, &fine_now)?;
         observer(&iteration);
@@ -269,8 +269,7 @@ fn begin(
         iterations: Vec::new(),
         stop_reason: None,
     };
-    write_trace_header(cx.dir)?;
-    append_trace(cx.dir, 0, s.fine_renders, 0.0, &s.current)?;
+    Trace::create(cx.dir)?.line(0, s.fine_renders, 0.0, &s.current)?;
     cx.dir.write_image(&snapshot_name(0), &img)?;
     save(cx.dir, &s, &img)?;
     Ok((s, img))
@@ -514,30 +513,6 @@ fn save(dir: &RunDir, state: &State, current: &Image) -> Result<()> {
     // The image first: a state file always has its render beside it.
     dir.write_image(SPACEMAP_CURRENT, current)?;
     dir.write_json(SPACEMAP_STATE, state)
-}
-
-fn write_trace_header(dir: &RunDir) -> Result<()> {
-    dir.write_text(
-        TRACE,
-        "# iteration fine_renders seconds deviation_average deviation_r deviation_g deviation_b\n",
-    )
-}
-
-/// One line of trace.tsv, in the columns a DE stage writes (generation =
-/// iteration, renders = fine renders), so the report reads both alike.
-fn append_trace(dir: &RunDir, k: usize, renders: usize, seconds: f64, d: &Deviation) -> Result<()> {
-    use std::io::Write;
-    let path = dir.file(TRACE);
-    let mut f = std::fs::OpenOptions::new()
-        .append(true)
-        .open(&path)
-        .map_err(|e| Error::io(&path, e))?;
-    writeln!(
-        f,
-        "{k} {renders} {seconds:.4} {:.4} {:.4} {:.4} {:.4}",
-        d.average, d.r, d.g, d.b
-    )
-    .map_err(|e| Error::io(&path, e))
 }
 
 /// fitted_scene.json, best.png, then result.json (its presence means the

@@ -14,7 +14,7 @@
 //! Principled BSDF for glass). `render.antialias` and `render.max_depth`
 //! are the built-in tracer's and unused here.
 
-use super::registry::Backend;
+use super::backend::Backend;
 use super::worker_start::PythonWorker;
 use super::{RenderSession, Renderer};
 use crate::error::Result;

@@ -11,8 +11,8 @@
 //! Both run in the user's working directory, so relative paths in the
 //! command work as typed. Every scene field is passed through unchanged.
 
+use super::backend::Backend;
 use super::external::{session_dir, ExternalSession, OneShotBackend};
-use super::registry::Backend;
 use super::{RenderOptions, RenderSession, Renderer};
 use crate::error::{Error, Result};
 use crate::exec::discover;

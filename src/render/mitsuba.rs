@@ -14,7 +14,7 @@
 //! worker's own `scenefit_phong` BSDF; principled for glass).
 //! `render.antialias` and `render.max_depth` are unused here.
 
-use super::registry::Backend;
+use super::backend::Backend;
 use super::worker_start::PythonWorker;
 use super::{RenderSession, Renderer};
 use crate::error::{Error, Result};

@@ -8,6 +8,7 @@ pub mod camera_effects;
 pub mod phong;
 pub mod srgb;
 
+pub mod backend;
 pub mod blender;
 pub mod command;
 pub mod external;
@@ -26,6 +27,7 @@ use crate::scene::{ParamSpace, Scene};
 
 pub use crate::exec::{RenderFailure, RenderOptions, RenderResult};
 pub use crate::raster::Image;
+pub use registry::{from_spec, from_spec_with};
 
 /// A backend. `session` prepares it to render many variants of one scene.
 pub trait Renderer: Send + Sync {
@@ -58,18 +60,6 @@ pub trait RenderSession: Send {
     /// Renders every scene; `seed` seeds sampling backends, the same for the
     /// whole batch so that candidates are not told apart by noise.
     fn render_batch(&mut self, scenes: &[Scene], seed: u64) -> Vec<RenderResult>;
-}
-
-/// The backend named by `spec` (see the module doc), followed by the
-/// camera's image-space effects (`camera_effects.rs`), with the defaults.
-pub fn from_spec(spec: &str) -> Result<Box<dyn Renderer>> {
-    from_spec_with(spec, &RenderOptions::default())
-}
-
-/// `from_spec` with the caller's options over the defaults.
-pub fn from_spec_with(spec: &str, opts: &RenderOptions) -> Result<Box<dyn Renderer>> {
-    let drawn = near_lights::WithNearLights(registry::build(spec, opts)?);
-    Ok(Box::new(camera_effects::WithCameraEffects(Box::new(drawn))))
 }
 
 /// Renders one scene once (for `scenefit render`).

@@ -13,7 +13,7 @@
 //! (the built-in tracer's grazing factor of the diffuse term). `indirect_light` is the built-in
 //! tracer's stand-in for what `render.indirect` traces: not refused.
 
-use super::registry::Refusal;
+use super::backend::Refusal;
 use crate::scene::{Falloff, LightKind, Scene};
 
 /// What the Blender worker cannot draw (`registry::Backend::supports`).

@@ -38,7 +38,7 @@
 //!   whatever its transparency (measured: the same image as the lobe in the
 //!   bottom finish).
 
-use super::registry::Refusal;
+use super::backend::Refusal;
 use crate::scene::{CameraKind, Falloff, LightKind, Material, Scene, ShapeKind, Vec3};
 use std::f64::consts::PI;
 use std::fmt::Write;

@@ -9,8 +9,8 @@
 //! centre (`-A`), as the built-in tracer does. `render.samples` and the
 //! sampler seed are unused: POV-Ray is deterministic.
 
+use super::backend::Backend;
 use super::external::{session_dir, ExternalSession, OneShotBackend};
-use super::registry::Backend;
 use super::{pov_sdl, RenderSession, Renderer};
 use crate::error::{Error, Result};
 use crate::exec::discover;

@@ -5,51 +5,10 @@
 //! before any renderer starts all go through this list; plug-ins
 //! (`cmd:`, `worker:`) are entries whose name is a prefix.
 
+pub use super::backend::{Backend, Refusal};
 use super::{phong, RenderOptions, RenderSession, Renderer};
 use crate::error::{Error, Result};
 use crate::scene::{ParamSpace, Scene};
-
-/// A scene field a backend cannot draw, and why.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct Refusal {
-    /// The field's path in the scene, e.g. `objects.ball.material.fresnel`.
-    pub field: String,
-    /// Why, and what to use instead.
-    pub why: String,
-}
-
-impl Refusal {
-    pub fn new(field: impl Into<String>, why: impl Into<String>) -> Refusal {
-        Refusal {
-            field: field.into(),
-            why: why.into(),
-        }
-    }
-}
-
-/// One backend.
-pub struct Backend {
-    /// The name on the command line; for a plug-in, the prefix before its
-    /// command (`cmd:`).
-    pub name: &'static str,
-    /// For a plug-in, what follows the prefix (`TEMPLATE`); None for a
-    /// plain name.
-    pub arg: Option<&'static str>,
-    /// One line: what draws the image.
-    pub about: &'static str,
-    /// The backend, given what follows the prefix (empty for a plain name).
-    pub build: fn(&str, RenderOptions) -> Box<dyn Renderer>,
-    /// Every field of the scene it cannot draw, and why; empty if it draws
-    /// all of it.
-    pub supports: fn(&Scene) -> Vec<Refusal>,
-}
-
-impl Backend {
-    /// How the name is written in help and errors: `phong`, `cmd:TEMPLATE`.
-    pub fn usage(&self) -> String {
-        format!("{}{}", self.name, self.arg.unwrap_or(""))
-    }
-}
 
 /// The built-in tracer: draws every field (it is the model).
 const PHONG: Backend = Backend {
@@ -137,6 +96,20 @@ impl Renderer for Checked {
         }
         self.inner.session(base, varying, jobs)
     }
+}
+
+/// The backend named by `spec` (see the module doc), followed by the
+/// camera's image-space effects (`camera_effects.rs`), with the defaults.
+pub fn from_spec(spec: &str) -> Result<Box<dyn Renderer>> {
+    from_spec_with(spec, &RenderOptions::default())
+}
+
+/// `from_spec` with the caller's options over the defaults.
+pub fn from_spec_with(spec: &str, opts: &RenderOptions) -> Result<Box<dyn Renderer>> {
+    let drawn = super::near_lights::WithNearLights(build(spec, opts)?);
+    Ok(Box::new(super::camera_effects::WithCameraEffects(
+        Box::new(drawn),
+    )))
 }
 
 #[cfg(test)]

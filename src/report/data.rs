@@ -3,15 +3,29 @@
 //! from trace.tsv (written by the pipeline, one line per generation with
 //! seconds) or else from progress.txt (every 10 generations, no seconds:
 //! seconds are then spread evenly over the generations from result.json's
-//! `wall_seconds`, and the report says so).
+//! `wall_seconds`, and the report says so); and all of a run directory,
+//! loaded (`Run`).
 
 use crate::error::{Error, Result};
 use crate::fit::FitResult;
-use crate::metric::Deviation;
+use crate::metric::{Deviation, Mask};
+use crate::pipeline::Comparison;
 use crate::raster::Image;
 use crate::rundir::{snapshot_generation, RunDir, BEST, FITTED_SCENE, PROGRESS, TRACE};
 use crate::scene::Scene;
 use std::path::{Path, PathBuf};
+
+/// What a run directory holds, loaded.
+pub struct Run {
+    pub dir: PathBuf,
+    pub stages: Vec<Stage>,
+    pub comparison: Option<Comparison>,
+    /// The DE stage 2 run beside the mapped one (`--stage2-method both`).
+    pub stage2_de: Option<Stage>,
+    /// The target, or why there is none.
+    pub target: std::result::Result<Image, String>,
+    pub mask: Option<Mask>,
+}
 
 /// One point of a convergence curve.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -27,8 +27,9 @@ mod tradeoffs;
 use crate::error::{Error, Result};
 use crate::metric::Mask;
 use crate::pipeline::Comparison;
-use crate::raster::{io as image_io, Image};
+use crate::raster::io as image_io;
 use crate::rundir::{RunDir, COMPARISON, REPORT, RESULT};
+pub use data::Run;
 use data::Stage;
 use std::path::{Path, PathBuf};
 
@@ -39,18 +40,6 @@ pub const FILE: &str = REPORT;
 pub struct ReportOptions {
     pub target: Option<PathBuf>,
     pub mask: Option<PathBuf>,
-}
-
-/// What a run directory holds, loaded.
-pub struct Run {
-    pub dir: PathBuf,
-    pub stages: Vec<Stage>,
-    pub comparison: Option<Comparison>,
-    /// The DE stage 2 run beside the mapped one (`--stage2-method both`).
-    pub stage2_de: Option<Stage>,
-    /// The target, or why there is none.
-    pub target: std::result::Result<Image, String>,
-    pub mask: Option<Mask>,
 }
 
 /// (Re)writes DIR/report.html and its figures; returns the page's path.
@@ -80,7 +69,7 @@ fn load(dir: &Path, options: &ReportOptions) -> Result<Run> {
         (vec![Stage::load(dir, "Fit")?], None)
     } else {
         return Err(Error::Usage(format!(
-            "{}: neither a fit directory (result.json) nor a pipeline directory (comparison.json); has the run finished?",
+            "{}: neither a fit directory ({RESULT}) nor a pipeline directory ({COMPARISON}); has the run finished?",
             dir.display()
         )));
     };

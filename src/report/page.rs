@@ -12,7 +12,10 @@ use super::{figure, Run};
 use crate::error::Result;
 use crate::metric::Deviation;
 use crate::raster::io as image_io;
-use crate::rundir::{COMPARISON, HANDOVER};
+use crate::rundir::{
+    BEST, COMPARISON, FITTED_SCENE, HANDOVER, INPUT_SCENE, MASK, PROGRESS, RESULT, SNAPSHOTS,
+    TARGET, TRACE,
+};
 
 /// The page of a loaded run.
 pub fn render(run: &Run) -> Result<String> {
@@ -316,10 +319,10 @@ fn cost(page: &mut Page, run: &Run) {
         ],
         &rows,
     );
-    page.note(if run.comparison.is_some() {
-        "Wall s: the whole stage, renderer start-up included; in generations s: result.json's wall_seconds, rendering and comparing only."
+    page.note(&if run.comparison.is_some() {
+        format!("Wall s: the whole stage, renderer start-up included; in generations s: {RESULT}'s wall_seconds, rendering and comparing only.")
     } else {
-        "Seconds: result.json's wall_seconds, the time spent in generations (renderer start-up not included)."
+        format!("Seconds: {RESULT}'s wall_seconds, the time spent in generations (renderer start-up not included).")
     });
 }
 
@@ -374,7 +377,7 @@ fn convergence(page: &mut Page, run: &Run) -> Result<()> {
     for s in &run.stages {
         if !s.seconds_measured {
             page.note(&format!(
-                "{}: no trace.tsv, so the curve is progress.txt's (every 10 generations) and its seconds assume every generation took the same time (wall_seconds / generations).",
+                "{}: no {TRACE}, so the curve is {PROGRESS}'s (every 10 generations) and its seconds assume every generation took the same time (wall_seconds / generations).",
                 s.title()
             ));
         }
@@ -426,13 +429,13 @@ fn evolution(page: &mut Page, run: &Run) -> Result<()> {
             Some(f) => page.figure(
                 &f,
                 &format!(
-                    "{}: the best image every 10 generations (best_gNNNN.bmp)",
+                    "{}: the best image every 10 generations ({SNAPSHOTS})",
                     s.title()
                 ),
                 true,
                 None,
             ),
-            None => page.note(&format!("{}: no best_gNNNN.bmp snapshots.", s.title())),
+            None => page.note(&format!("{}: no {SNAPSHOTS} snapshots.", s.title())),
         }
     }
     Ok(())
@@ -450,32 +453,29 @@ fn files(page: &mut Page, run: &Run) {
         COMPARISON.into(),
         "both stages' deviation, renders and seconds",
     );
-    add(
-        "target.png".into(),
-        "the target both stages were compared with",
-    );
-    add("mask.png".into(), "the mask (white: pixels that count)");
+    add(TARGET.into(), "the target both stages were compared with");
+    add(MASK.into(), "the mask (white: pixels that count)");
     for i in 0..run.stages.len() {
         let r = rel(run, i);
         add(
-            format!("{r}input_scene.json"),
+            format!("{r}{INPUT_SCENE}"),
             "the scene stage 2 searched (narrowed bounds)",
         );
         add(
-            format!("{r}result.json"),
+            format!("{r}{RESULT}"),
             "fitted values, deviation, renders, seconds",
         );
         add(
-            format!("{r}fitted_scene.json"),
+            format!("{r}{FITTED_SCENE}"),
             "the scene with the fitted values",
         );
-        add(format!("{r}best.png"), "the best render, full size");
+        add(format!("{r}{BEST}"), "the best render, full size");
         add(
-            format!("{r}progress.txt"),
+            format!("{r}{PROGRESS}"),
             "best deviation and parameters every 10 generations",
         );
         add(
-            format!("{r}trace.tsv"),
+            format!("{r}{TRACE}"),
             "best deviation and seconds every generation",
         );
     }
@@ -492,5 +492,5 @@ fn files(page: &mut Page, run: &Run) {
         add(format!("{stem}.svg"), "figure, vector");
     }
     page.links(&list);
-    page.note("Regenerate this page with: scenefit report DIR. Render a fitted scene large with: scenefit render fitted_scene.json --renderer blender --width 1280 --height 960 -o big.png");
+    page.note(&format!("Regenerate this page with: scenefit report DIR. Render a fitted scene large with: scenefit render {FITTED_SCENE} --renderer blender --width 1280 --height 960 -o big.png"));
 }

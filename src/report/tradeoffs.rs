@@ -10,6 +10,7 @@ use super::plots::Scatter;
 use super::population::{self, Population, TradeOff};
 use super::{figure, Run};
 use crate::error::Result;
+use crate::rundir::CHECKPOINT;
 
 pub fn section(page: &mut Page, run: &Run) -> Result<()> {
     page.h2("What the image does not determine", "trade-offs");
@@ -20,7 +21,7 @@ pub fn section(page: &mut Page, run: &Run) -> Result<()> {
         match population::load(&s.dir) {
             Ok(p) => population_section(page, run, i, s, &p)?,
             Err(why) => page.note(&format!(
-                "{}: no final population ({why}). A finished fit keeps it in its checkpoint.json.",
+                "{}: no final population ({why}). A finished fit keeps it in its {CHECKPOINT}.",
                 s.title()
             )),
         }

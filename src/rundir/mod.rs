@@ -57,6 +57,15 @@ pub const COMPARISON: &str = "comparison.json";
 /// The HTML report and its figures' folder.
 pub const REPORT: &str = "report.html";
 pub const FIGURES: &str = "figures";
+/// A diagnosis: diagnosis.json (the `Diagnosis` fields), the extended
+/// scene with its refitted values, heatmaps of the residual before and
+/// after (on one scale), and the render of the improved scene; its page
+/// is `REPORT`.
+pub const DIAGNOSIS_JSON: &str = "diagnosis.json";
+pub const IMPROVED_SCENE: &str = "improved_scene.json";
+pub const RESIDUAL_BEFORE: &str = "residual_before.png";
+pub const RESIDUAL_AFTER: &str = "residual_after.png";
+pub const RENDER_AFTER: &str = "render_after.png";
 /// A pipeline's stage directories.
 pub const STAGE1: &str = "stage1";
 pub const STAGE2: &str = "stage2";
@@ -71,6 +80,21 @@ const LOCK: &str = ".scenefit.lock";
 pub fn shot_best_name(shot: &str) -> String {
     format!("best_{shot}.png")
 }
+
+/// A set diagnosis's per-photograph files: the render after, and the
+/// residual heatmaps before and after (one scale for the whole set).
+pub fn shot_render_after(shot: &str) -> String {
+    format!("render_after_{shot}.png")
+}
+pub fn shot_residual_before(shot: &str) -> String {
+    format!("residual_before_{shot}.png")
+}
+pub fn shot_residual_after(shot: &str) -> String {
+    format!("residual_after_{shot}.png")
+}
+
+/// The snapshots' names as a reader is told them.
+pub const SNAPSHOTS: &str = "best_gNNNN.bmp";
 
 pub fn snapshot_name(generation: usize) -> String {
     format!("best_g{generation:04}.bmp")

@@ -4,14 +4,14 @@
 //! not searched: it adds no free entries.
 
 use super::Effect;
-use crate::diagnose::residual::Features;
+use crate::diagnose::features::Features;
 use crate::scene::{FreeParam, Scene};
 
 pub struct AlbedoMap;
 
 impl Effect for AlbedoMap {
     fn name(&self) -> &'static str {
-        crate::diagnose::albedo::NAME
+        "albedo_map"
     }
 
     /// R: a map scales the render where it is lit (a gain that varies from

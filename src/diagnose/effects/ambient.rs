@@ -3,7 +3,7 @@
 
 use super::edit::{free, is_free};
 use super::Effect;
-use crate::diagnose::residual::Features;
+use crate::diagnose::features::Features;
 use crate::scene::{Bound, Field, FreeParam, Scene};
 
 pub struct Ambient;

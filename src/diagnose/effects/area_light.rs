@@ -3,7 +3,7 @@
 
 use super::edit::{is_free, scalar};
 use super::Effect;
-use crate::diagnose::residual::Features;
+use crate::diagnose::features::Features;
 use crate::math::V3;
 use crate::scene::field::LightField;
 use crate::scene::{Field, FreeParam, LightKind, Scene};

@@ -4,7 +4,7 @@
 
 use super::edit::{closer, field_of, scalar, Trades, DISTANCES};
 use super::Effect;
-use crate::diagnose::residual::Features;
+use crate::diagnose::features::Features;
 use crate::raster::encoding::srgb_from_linear;
 use crate::scene::field::{CameraField, MaterialField};
 use crate::scene::{ColorSpace, Field, FreeParam, Response, ResponseEncoding, Scene, Value};

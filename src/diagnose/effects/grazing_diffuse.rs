@@ -7,7 +7,7 @@
 
 use super::edit::{is_free, scalar};
 use super::Effect;
-use crate::diagnose::residual::Features;
+use crate::diagnose::features::Features;
 use crate::scene::field::MaterialField;
 use crate::scene::{Field, FreeParam, Scene};
 

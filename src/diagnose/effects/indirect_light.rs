@@ -3,7 +3,7 @@
 
 use super::edit::scalar;
 use super::Effect;
-use crate::diagnose::residual::Features;
+use crate::diagnose::features::Features;
 use crate::scene::{Field, FreeParam, Scene};
 
 pub struct IndirectLight;

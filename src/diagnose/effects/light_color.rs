@@ -6,7 +6,7 @@
 
 use super::edit::{field_of, free, is_free};
 use super::Effect;
-use crate::diagnose::residual::Features;
+use crate::diagnose::features::Features;
 use crate::scene::field::LightField;
 use crate::scene::{Bound, Field, FreeParam, Scene};
 

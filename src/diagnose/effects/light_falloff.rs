@@ -3,7 +3,7 @@
 
 use super::edit::{closer, field_of, scalar, Trades, DISTANCES};
 use super::Effect;
-use crate::diagnose::residual::Features;
+use crate::diagnose::features::Features;
 use crate::scene::field::LightField;
 use crate::scene::{Falloff, Field, FreeParam, LightKind, Scene, Value};
 

@@ -6,7 +6,7 @@
 
 use super::edit::{field_of, scalar, scale, Trades};
 use super::Effect;
-use crate::diagnose::residual::Features;
+use crate::diagnose::features::Features;
 use crate::scene::field::LightField;
 use crate::scene::{Field, FreeParam, LightKind, Scene, Value};
 

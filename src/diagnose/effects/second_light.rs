@@ -2,7 +2,7 @@
 
 use super::edit::{free, free_entry, scalar, scale};
 use super::Effect;
-use crate::diagnose::residual::Features;
+use crate::diagnose::features::Features;
 use crate::scene::field::LightField;
 use crate::scene::{Bound, Field, FreeParam, Light, LightKind, Scene};
 

@@ -3,7 +3,7 @@
 
 use super::edit::{glossy, scalar};
 use super::Effect;
-use crate::diagnose::residual::Features;
+use crate::diagnose::features::Features;
 use crate::scene::field::MaterialField;
 use crate::scene::{Field, FreeParam, Scene};
 

@@ -5,7 +5,7 @@
 //! absolute paths, for `diagnose`).
 
 use super::state::SetState;
-use super::{problem::counted, varying, SetConfig};
+use super::{problem::counted, varying, SetConfig, ShotResult};
 use crate::error::{Error, Result};
 use crate::fit::set::shots::{Shot, ShotsFile, FORMAT};
 use crate::fit::{render_seed, FitResult};
@@ -14,16 +14,6 @@ use crate::raster::Image;
 use crate::render::Renderer;
 use crate::rundir::{shot_best_name, RunDir, FITTED_SCENE, RESULT, SHOTS};
 use crate::scene::{ParamSpace, Scene};
-use serde::{Deserialize, Serialize};
-
-/// One photograph's part of result.json.
-#[derive(Clone, Debug, Serialize, Deserialize)]
-pub struct ShotResult {
-    pub name: String,
-    /// This photograph's own parameters.
-    pub params: serde_json::Map<String, serde_json::Value>,
-    pub deviation: Deviation,
-}
 
 /// One photograph's fit, in memory.
 #[derive(Clone, Debug)]

@@ -12,10 +12,6 @@ use crate::math::V3;
 
 /// Shadow rays per hit towards an area light.
 const AREA_SAMPLES: usize = 16;
-/// Virtual point lights of the one-bounce estimate.
-const BOUNCE_LIGHTS: usize = 64;
-/// Keeps the one-bounce kernel finite where two hits nearly touch (m^2).
-const BOUNCE_EPS: f32 = 0.01;
 
 fn at(pk: &Packed, i: usize) -> V3 {
     V3::new(pk.px[i] as f64, pk.py[i] as f64, pk.pz[i] as f64)
@@ -306,53 +302,6 @@ pub fn specular(
         r[i] += s * power[0];
         g[i] += s * power[1];
         b[i] += s * power[2];
-    }
-}
-
-/// The one-bounce kernel of a set of hits: for each hit, the virtual
-/// point lights (hits spread evenly through the list) it sees and the
-/// geometric factor cos_i cos_j / (d^2 (d^2 + eps)) of each. It depends
-/// on the hits alone, so a session whose geometry does not move computes
-/// it once (`Packed::bounce`) and a render only weighs the lights' colours.
-pub struct Bounce {
-    /// Packed index of each virtual point light.
-    vpl: Vec<usize>,
-    /// `terms[offsets[i]..offsets[i + 1]]`: hit i's (light, factor) pairs.
-    offsets: Vec<u32>,
-    terms: Vec<(u16, f32)>,
-}
-
-impl Bounce {
-    pub fn new(pk: &Packed) -> Bounce {
-        let n = pk.n;
-        let stride = (n / BOUNCE_LIGHTS).max(1);
-        let vpl: Vec<usize> = (stride / 2..n)
-            .step_by(stride)
-            .take(BOUNCE_LIGHTS)
-            .collect();
-        let mut offsets = Vec::with_capacity(n + 1);
-        let mut terms = Vec::new();
-        offsets.push(0);
-        for i in 0..n {
-            let (px, py, pz) = (pk.px[i], pk.py[i], pk.pz[i]);
-            let (nx, ny, nz) = (pk.nx[i], pk.ny[i], pk.nz[i]);
-            for (s, &j) in vpl.iter().enumerate() {
-                let (wx, wy, wz) = (pk.px[j] - px, pk.py[j] - py, pk.pz[j] - pz);
-                let ci = nx * wx + ny * wy + nz * wz;
-                let cj = -(pk.nx[j] * wx + pk.ny[j] * wy + pk.nz[j] * wz);
-                if ci <= 0.0 || cj <= 0.0 {
-                    continue;
-                }
-                let d2 = wx * wx + wy * wy + wz * wz;
-                terms.push((s as u16, ci * cj / (d2 * (d2 + BOUNCE_EPS))));
-            }
-            offsets.push(terms.len() as u32);
-        }
-        Bounce {
-            vpl,
-            offsets,
-            terms,
-        }
     }
 }
 

@@ -5,6 +5,7 @@
 //! possible blockers, quads, turning lights) stays on a short list tested
 //! the general way.
 
+use super::bounce::Bounce;
 use super::geometry::Occluder;
 use super::paths::{Paths, Shadow, NO_PARENT};
 
@@ -48,7 +49,7 @@ pub struct Packed {
     /// of each packed hit (no weights to propagate).
     pub direct_pixel: Option<Vec<u32>>,
     /// The one-bounce kernel, built on first use (`effects.rs`).
-    bounce: std::sync::OnceLock<super::effects::Bounce>,
+    bounce: std::sync::OnceLock<Bounce>,
     /// For each group, the primitives of other objects (which alone can
     /// shadow a convex object's hits), built on first use.
     others: std::sync::OnceLock<Vec<Vec<u32>>>,
@@ -137,9 +138,13 @@ impl Packed {
     }
 
     /// The one-bounce kernel of these hits.
-    pub fn bounce(&self) -> &super::effects::Bounce {
-        self.bounce
-            .get_or_init(|| super::effects::Bounce::new(self))
+    pub fn bounce(&self) -> &Bounce {
+        self.bounce.get_or_init(|| {
+            Bounce::new(
+                [&self.px, &self.py, &self.pz],
+                [&self.nx, &self.ny, &self.nz],
+            )
+        })
     }
 
     /// For each group, the primitives of `geo` owned by other objects. Our
