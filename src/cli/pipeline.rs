@@ -98,7 +98,7 @@ struct MethodArgs {
 
 pub fn run(a: PipelineArgs) -> Result<()> {
     if let Some(f) = &a.font {
-        report::font::use_file(f.clone());
+        report::font::use_file(f.clone())?;
     }
     let scene = load_with(&a.inputs.scene, &a.set)?;
     let (target, note) = a.inputs.target(&scene)?;

@@ -28,7 +28,7 @@ pub struct ReportArgs {
 
 pub fn run(a: ReportArgs) -> Result<()> {
     if let Some(f) = a.font {
-        report::font::use_file(f);
+        report::font::use_file(f)?;
     }
     let path = report::write(
         &a.dir,
