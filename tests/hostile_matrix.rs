@@ -616,3 +616,46 @@ fn the_stand_ins_are_what_they_claim() {
     let link = std::fs::read_link(made("symlink out of the directory")).unwrap();
     assert_eq!(link, d.path().join("elsewhere"));
 }
+
+/// A worker's output is read through the same opener: a FIFO (no writer)
+/// or a link to /dev/zero left where the image should be fails the render
+/// at once (exit 1, one line saying what the file is), well within
+/// `--render-timeout`, instead of hanging or reading without end.
+#[test]
+fn a_worker_output_that_is_a_fifo_or_a_device_fails_at_once() {
+    if Command::new("python3").arg("--version").output().is_err() {
+        assert_ne!(std::env::var("CI").as_deref(), Ok("true"), "python3 is needed");
+        eprintln!("skipped: no python3");
+        return;
+    }
+    let d = tempfile::tempdir().unwrap();
+    let mut scene = json(&scenes().join("sphere_floor.json"));
+    scene["image"] = json!({"width": 16, "height": 12});
+    write(&d.path().join("s.json"), scene.to_string().as_bytes());
+    let faulty = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/plugins/faulty.py");
+    for (mode, says) in [("fifo", "a FIFO"), ("devzero", "a device")] {
+        let worker = format!(
+            "worker:python3 {} --worker --fault {mode}",
+            faulty.display()
+        );
+        let args = [
+            "render",
+            "s.json",
+            "-o",
+            "out.png",
+            "--renderer",
+            &worker,
+            "--render-timeout",
+            "30",
+        ];
+        let (code, err, took) = run_bounded(d.path(), &args);
+        assert_eq!(code, Some(1), "{mode}: {err}");
+        assert_eq!(err.lines().count(), 1, "{mode}: {err}");
+        assert!(
+            err.contains(says) && err.contains("expected a regular file"),
+            "{mode}: {err}"
+        );
+        assert!(took < Duration::from_secs(15), "{mode}: {took:?}");
+        assert!(!d.path().join("out.png").exists());
+    }
+}
