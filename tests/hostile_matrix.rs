@@ -624,7 +624,11 @@ fn the_stand_ins_are_what_they_claim() {
 #[test]
 fn a_worker_output_that_is_a_fifo_or_a_device_fails_at_once() {
     if Command::new("python3").arg("--version").output().is_err() {
-        assert_ne!(std::env::var("CI").as_deref(), Ok("true"), "python3 is needed");
+        assert_ne!(
+            std::env::var("CI").as_deref(),
+            Ok("true"),
+            "python3 is needed"
+        );
         eprintln!("skipped: no python3");
         return;
     }
