@@ -2,7 +2,7 @@
 //! in turn by each of the same hostile stand-ins, run through the real
 //! binary with a timeout. Generated from two tables, [`INPUTS`] (one line
 //! per command and file it reads) and [`STAND_INS`], so that an input
-//! added later is covered by adding one line.
+//! added later is covered by adding one entry.
 //!
 //! Every case must: exit 2 (bad input) or 1 (failed run); print one line
 //! that names the file; never panic; finish within `TIME_BOUND` (a FIFO
@@ -44,7 +44,7 @@ struct Input {
 /// input still ends within the bound.
 const G: &[&str] = &["-q", "--population", "6", "--generations", "2"];
 
-/// Commands x the files they read. `demo` reads no file (its scene and
+/// Commands x the files they read, one entry each. `demo` reads no file (its scene and
 /// targets are built in), so it has no line.
 const INPUTS: &[Input] = &[
     Input {
