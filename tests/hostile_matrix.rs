@@ -1,6 +1,6 @@
 //! The hostile matrix (issue 30): every file every command reads, replaced
 //! in turn by each of the same hostile stand-ins, run through the real
-//! binary with a timeout. Generated from two tables, [`INPUTS`] (one line
+//! binary with a timeout. Generated from two tables, [`INPUTS`] (one entry
 //! per command and file it reads) and [`STAND_INS`], so that an input
 //! added later is covered by adding one entry.
 //!
@@ -44,8 +44,8 @@ struct Input {
 /// input still ends within the bound.
 const G: &[&str] = &["-q", "--population", "6", "--generations", "2"];
 
-/// Commands x the files they read, one entry each. `demo` reads no file (its scene and
-/// targets are built in), so it has no line.
+/// Commands x the files they read, one entry each. `demo` reads no
+/// file (its scene and targets are built in), so it has no entry.
 const INPUTS: &[Input] = &[
     Input {
         label: "render",
