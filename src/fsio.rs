@@ -66,54 +66,9 @@ pub fn is_temp_name(name: &str) -> bool {
     name.starts_with('.') && name.contains(".tmp.")
 }
 
-/// The most a JSON file the tool reads back (a result, a checkpoint) may
-/// hold: far above any real one, far below what would exhaust memory.
-pub const MAX_JSON_BYTES: u64 = 256 << 20;
-
-/// Why a capped read gave no bytes; each caller words it for its file.
-#[derive(Debug)]
-pub enum CappedRead {
-    Io(std::io::Error),
-    Directory,
-    /// Longer than the limit (or a device such as /dev/zero).
-    TooLarge,
-}
-
-/// Reads at most `limit` bytes of `path`: a longer file is refused, not
-/// read to its end.
-pub fn read_capped(path: &Path, limit: u64) -> std::result::Result<Vec<u8>, CappedRead> {
-    use std::io::Read;
-    let file = std::fs::File::open(path).map_err(CappedRead::Io)?;
-    if file.metadata().map(|m| m.is_dir()).unwrap_or(false) {
-        return Err(CappedRead::Directory);
-    }
-    let mut bytes = Vec::new();
-    file.take(limit + 1)
-        .read_to_end(&mut bytes)
-        .map_err(CappedRead::Io)?;
-    if bytes.len() as u64 > limit {
-        return Err(CappedRead::TooLarge);
-    }
-    Ok(bytes)
-}
-
-/// Reads a text file the tool wrote, of at most `limit` bytes.
-pub fn read_text_capped(path: &Path, limit: u64) -> Result<String> {
-    let bytes = read_capped(path, limit).map_err(|e| match e {
-        CappedRead::Io(e) => Error::io(path, e),
-        CappedRead::Directory => Error::Usage(format!(
-            "{}: a directory, not a file scenefit wrote",
-            path.display()
-        )),
-        CappedRead::TooLarge => Error::Usage(format!(
-            "{}: larger than {} MiB; not a file scenefit wrote",
-            path.display(),
-            limit >> 20
-        )),
-    })?;
-    String::from_utf8(bytes)
-        .map_err(|_| Error::Usage(format!("{}: not UTF-8 text", path.display())))
-}
+// Reading lives in `input`, the one way to open an input; these names
+// stay for the callers that read through `fsio`.
+pub use crate::input::{read_capped, read_text_capped, CappedRead, MAX_JSON_BYTES};
 
 fn parent(path: &Path) -> &Path {
     path.parent()

@@ -8,6 +8,7 @@ pub mod error;
 pub mod exec;
 pub mod fit;
 pub mod fsio;
+pub mod input;
 pub mod math;
 pub mod metric;
 pub mod optimize;

@@ -489,7 +489,10 @@ fn cases() -> Vec<Case> {
         args: ["render", "/dev/zero", "-o", "out.png"]
             .map(String::from)
             .to_vec(),
-        needles: vec!["/dev/zero".into(), "larger than 64 MiB".into()],
+        needles: vec![
+            "/dev/zero".into(),
+            "a device; expected a regular file".into(),
+        ],
     });
     c.push(Case {
         label: "directory as scene".into(),
@@ -512,7 +515,7 @@ fn cases() -> Vec<Case> {
     c.last_mut().unwrap().needles = vec![
         "/dev/zero".into(),
         "--target".into(),
-        "larger than 1024 MiB".into(),
+        "a device; expected a regular file".into(),
     ];
     // Options of a set fit without a set: refused, not silently ignored.
     for flag in [&["--joint"][..], &["--rounds", "2"][..]] {
@@ -527,7 +530,7 @@ fn cases() -> Vec<Case> {
         "/dev/zero as mask",
         plain.clone(),
         &["--mask", "/dev/zero"],
-        &["--mask", "larger than 1024 MiB"],
+        &["--mask", "a device; expected a regular file"],
     ));
     let mut huge = fit_case(
         "target declaring 20000x20000",
@@ -678,4 +681,55 @@ fn scenes_at_the_limits_still_render() {
     let out = scenefit(d.path(), &["render", "s.json", "-o", "out.png"]);
     assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
     assert!(d.path().join("out.png").exists());
+}
+
+/// A float target's NaN and infinite pixels are left out with their count,
+/// never fitted as black; a target with no finite pixel is refused.
+#[test]
+fn nan_targets_are_masked_or_refused() {
+    let d = tempfile::tempdir().unwrap();
+    let mut v = base();
+    v["image"] = json!({"width": 16, "height": 12});
+    std::fs::write(d.path().join("s.json"), v.to_string()).unwrap();
+    let exr = |name: &str, bad: usize| {
+        let mut img = image::Rgb32FImage::from_pixel(16, 12, image::Rgb([0.2, 0.2, 0.2]));
+        for (i, p) in img.pixels_mut().take(bad).enumerate() {
+            p.0[i % 3] = if i % 2 == 0 { f32::NAN } else { f32::INFINITY };
+        }
+        img.save(d.path().join(name)).unwrap();
+    };
+    exr("part.exr", 7);
+    exr("all.exr", 16 * 12);
+    let fit = |target: &str, out: &str| {
+        scenefit(
+            d.path(),
+            &[
+                "fit",
+                "s.json",
+                "--target",
+                target,
+                "-o",
+                out,
+                "--population",
+                "6",
+                "--generations",
+                "2",
+            ],
+        )
+    };
+    let o = fit("part.exr", "part");
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(0), "{err}");
+    assert!(
+        err.contains("part.exr: 7 pixels with a NaN or infinite channel left out of the fit"),
+        "{err}"
+    );
+    let o = fit("all.exr", "all");
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(
+        err.contains("all.exr") && err.contains("every pixel is NaN or infinite"),
+        "{err}"
+    );
 }

@@ -57,13 +57,14 @@ fn fill(mut o: RenderOptions, var: impl Fn(&str) -> Option<String>) -> Result<Re
 
 /// Draws the report's figures with the font `flag` names, else the one
 /// `SCENEFIT_FONT` names, else a system font.
-pub fn use_font(flag: Option<PathBuf>) {
+pub fn use_font(flag: Option<PathBuf>) -> Result<()> {
     let named = match flag {
         Some(p) => Some(("--font", p)),
         None => std::env::var_os(FONT).map(|p| (FONT, PathBuf::from(p))),
     };
-    if let Some((source, path)) = named {
-        crate::report::font::use_file(source, path);
+    match named {
+        Some((source, path)) => crate::report::font::use_file(source, path),
+        None => Ok(()),
     }
 }
 

@@ -97,7 +97,7 @@ struct MethodArgs {
 }
 
 pub fn run(a: PipelineArgs) -> Result<()> {
-    super::env::use_font(a.font.clone());
+    super::env::use_font(a.font.clone())?;
     let scene = load_with(&a.inputs.scene, &a.set)?;
     let (target, note) = a.inputs.target(&scene)?;
     let opts = a.render_options.options_in(&a.output)?;

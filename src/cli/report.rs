@@ -27,7 +27,7 @@ pub struct ReportArgs {
 }
 
 pub fn run(a: ReportArgs) -> Result<()> {
-    super::env::use_font(a.font);
+    super::env::use_font(a.font)?;
     let path = report::write(
         &a.dir,
         &ReportOptions {

@@ -199,7 +199,7 @@ impl Drop for Slurm {
 
 /// Removes `prefix` from the ledger; removes the ledger when it is empty.
 fn forget(path: &Path, prefix: &str) {
-    let Ok(text) = std::fs::read_to_string(path) else {
+    let Ok(text) = crate::input::read_text_capped(path, crate::input::MAX_TEXT_BYTES) else {
         return;
     };
     let rest: Vec<&str> = text
@@ -233,8 +233,18 @@ fn alive(prefix: &str) -> bool {
 /// run directory's ledger `path`, and says which job ids those were. The
 /// ledger is then removed (the prefixes of a run still alive are kept).
 pub fn clean_ledger(path: &Path) {
-    let Ok(text) = std::fs::read_to_string(path) else {
-        return;
+    // bounded: the ledger is read on every run, whatever stands in its place
+    let text = match crate::input::read_text_capped(path, crate::input::MAX_TEXT_BYTES) {
+        Ok(t) => t,
+        Err(crate::error::Error::Io { source, .. })
+            if source.kind() == std::io::ErrorKind::NotFound =>
+        {
+            return
+        }
+        Err(e) => {
+            eprintln!("scenefit: warning: {e}; no Slurm jobs of an earlier run are cancelled");
+            return;
+        }
     };
     if which::which("squeue").is_err() {
         // kept for a run where Slurm can be asked

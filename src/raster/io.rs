@@ -4,6 +4,7 @@
 use super::{Encoding, Image, Photo};
 use crate::error::{Error, Result};
 use crate::fsio::{self, CappedRead};
+use crate::input::decode;
 use std::path::Path;
 
 /// The largest image file read, bytes.
@@ -19,10 +20,11 @@ pub fn read_image(path: &Path, what: &str) -> Result<Image> {
     Ok(Photo::from_decoded(img, Encoding::default_for(format)).image)
 }
 
-/// Reads at most `MAX_IMAGE_FILE_BYTES` of `path` and decodes it (PNG, BMP,
-/// TIFF or OpenEXR, at any depth), after checking the dimensions the header
-/// declares (at most `MAX_SIDE`, and `expect` when given) so that nothing
-/// large is allocated for a bad file. Returns the image and its format.
+/// Reads at most `MAX_IMAGE_FILE_BYTES` of the regular file `path` and
+/// decodes it (PNG, BMP, TIFF or OpenEXR, at any depth), after checking the
+/// dimensions the header declares (at most `MAX_SIDE`, and `expect` when
+/// given) so that nothing large is allocated for a bad file, and with the
+/// memory its size needs (`decode`). Returns the image and its format.
 pub fn read_decoded(
     path: &Path,
     what: &str,
@@ -33,6 +35,8 @@ pub fn read_decoded(
         message: format!("{what}: {message}"),
     };
     let bytes = fsio::read_capped(path, MAX_IMAGE_FILE_BYTES).map_err(|e| match e {
+        // not a regular file: said with the option that named it
+        CappedRead::Io(e) if e.kind() == std::io::ErrorKind::InvalidInput => bad(e.to_string()),
         CappedRead::Io(e) => Error::io(path, e),
         CappedRead::Directory => bad("is a directory; expected an image file".into()),
         CappedRead::TooLarge => bad(format!(
@@ -40,20 +44,11 @@ pub fn read_decoded(
             MAX_IMAGE_FILE_BYTES >> 20
         )),
     })?;
-    let undecodable = |e: image::ImageError| {
-        bad(format!(
-            "expected a PNG, BMP, TIFF or OpenEXR image, could not decode it ({e})"
-        ))
-    };
-    let reader = || {
-        image::ImageReader::new(std::io::Cursor::new(&bytes[..]))
-            .with_guessed_format()
-            .map_err(|e| Error::io(path, e))
-    };
-    let format = reader()?.format().ok_or_else(|| {
-        bad("expected a PNG, BMP, TIFF or OpenEXR image, could not decode it (none of these formats)".into())
-    })?;
-    let (w, h) = reader()?.into_dimensions().map_err(undecodable)?;
+    if bytes.is_empty() {
+        return Err(bad(format!("empty; expected {}", decode::FORMATS)));
+    }
+    let (format, w, h) =
+        decode::header(&bytes, None).map_err(|r| bad(r.describe(decode::FORMATS)))?;
     if w == 0 || h == 0 || w > MAX_SIDE || h > MAX_SIDE {
         return Err(bad(format!(
             "expected width and height between 1 and {MAX_SIDE}, got {w}x{h}"
@@ -66,7 +61,8 @@ pub fn read_decoded(
             )));
         }
     }
-    let img = reader()?.decode().map_err(undecodable)?;
+    let img = decode::decode(&bytes, format, MAX_SIDE, crate::scene::memory::available())
+        .map_err(|r| bad(r.describe(decode::FORMATS)))?;
     Ok((img, format))
 }
 

@@ -21,6 +21,9 @@ pub struct Photo {
     /// Indices (y * width + x) of the pixels with a channel at the format's
     /// maximum.
     pub saturated: Vec<u32>,
+    /// Indices of the pixels with a channel that is not a number or is
+    /// infinite (a float file): their levels are 0, and they say nothing.
+    pub non_finite: Vec<u32>,
     pub encoding: Encoding,
     /// Bits per channel of the file: 8, 16 or 32 (float).
     pub bits: u8,
@@ -73,6 +76,7 @@ struct Accumulator {
     encoding: Encoding,
     levels: Vec<f32>,
     saturated: Vec<u32>,
+    non_finite: Vec<u32>,
     bits: u8,
 }
 
@@ -82,6 +86,7 @@ impl Accumulator {
             encoding,
             levels: Vec::with_capacity(pixels * 3),
             saturated: Vec::new(),
+            non_finite: Vec::new(),
             bits: 8,
         }
     }
@@ -104,9 +109,20 @@ impl Accumulator {
             if px.iter().any(|&v| at_max(v)) {
                 self.saturated.push(i as u32);
             }
+            // NaN or Inf (only a float file has them): level 0, and listed
+            // so that the fit leaves the pixel out rather than see black
+            let finite = px.iter().all(|&v| unit(v).is_finite());
+            if !finite {
+                self.non_finite.push(i as u32);
+            }
             for c in 0..3 {
-                let v = px[c.min(colour - 1)];
-                self.levels.push(self.encoding.to_srgb(unit(v)) * 255.0);
+                let v = unit(px[c.min(colour - 1)]);
+                let level = if finite {
+                    self.encoding.to_srgb(v) * 255.0
+                } else {
+                    0.0
+                };
+                self.levels.push(level);
             }
         }
     }
@@ -119,6 +135,7 @@ impl Accumulator {
             image,
             levels: self.levels,
             saturated: self.saturated,
+            non_finite: self.non_finite,
             encoding: self.encoding,
             bits: self.bits,
         }
@@ -184,6 +201,31 @@ mod tests {
         assert_eq!(p.image.get_pixel(0, 0).0, [255, 255, 255]);
         assert_eq!(p.saturated, vec![0]);
         assert!(p.is_plain());
+    }
+
+    #[test]
+    fn nan_and_inf_are_listed_and_read_as_zero() {
+        let img = image::ImageBuffer::from_raw(
+            3,
+            1,
+            vec![
+                0.5f32,
+                0.5,
+                0.5,
+                f32::NAN,
+                0.5,
+                0.5,
+                0.5,
+                f32::INFINITY,
+                0.5,
+            ],
+        )
+        .unwrap();
+        let p = Photo::from_decoded(DynamicImage::ImageRgb32F(img), Encoding::Linear);
+        assert_eq!(p.non_finite, vec![1, 2]);
+        assert!(p.levels.iter().all(|l| l.is_finite()));
+        assert_eq!(&p.levels[3..9], &[0.0; 6]);
+        assert!(p.levels[0] > 100.0);
     }
 
     #[test]

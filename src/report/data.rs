@@ -81,11 +81,10 @@ impl Stage {
 
 /// trace.tsv, or None when there is none.
 fn read_trace(path: &Path) -> Result<Option<Vec<CurvePoint>>> {
-    let text = match std::fs::read_to_string(path) {
-        Ok(t) => t,
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
-        Err(e) => return Err(Error::io(path, e)),
-    };
+    if !path.exists() {
+        return Ok(None);
+    }
+    let text = crate::input::read_text_capped(path, crate::input::MAX_TEXT_BYTES)?;
     let mut points = Vec::new();
     for (i, line) in text.lines().enumerate() {
         if line.starts_with('#') || line.trim().is_empty() {
@@ -122,7 +121,7 @@ fn read_trace(path: &Path) -> Result<Option<Vec<CurvePoint>>> {
 /// generations. Seconds: the run's `wall_seconds` spread evenly over its
 /// generations (generation 0, the initial population, counts as one).
 pub fn read_progress(path: &Path, result: &FitResult) -> Result<Vec<CurvePoint>> {
-    let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+    let text = crate::input::read_text_capped(path, crate::input::MAX_TEXT_BYTES)?;
     let per_generation = result.wall_seconds / (result.generations + 1) as f64;
     let mut points = Vec::new();
     for (i, line) in text.lines().enumerate() {

@@ -81,39 +81,35 @@ pub fn get(path: &Path) -> Result<Arc<AlbedoMap>> {
     Ok(map)
 }
 
-/// Reads an OpenEXR file of linear multipliers (at most
-/// `MAX_MAP_BYTES`, its header's size checked before decoding).
+/// Reads an OpenEXR file of linear multipliers (a regular file of at
+/// most `MAX_MAP_BYTES`, its header's size checked before decoding).
 fn read(path: &Path) -> Result<AlbedoMap> {
+    use crate::fsio::CappedRead;
+    use crate::input::decode;
     let bad = |m: String| Error::Image {
         path: path.to_path_buf(),
         message: format!("albedo_map: {m}"),
     };
     let bytes = crate::fsio::read_capped(path, MAX_MAP_BYTES).map_err(|e| match e {
-        crate::fsio::CappedRead::Io(e) => Error::io(path, e),
+        CappedRead::Io(e) if e.kind() == std::io::ErrorKind::InvalidInput => bad(e.to_string()),
+        CappedRead::Io(e) => Error::io(path, e),
         _ => bad(format!(
             "expected a file of at most {} MiB",
             MAX_MAP_BYTES >> 20
         )),
     })?;
-    let reader = || {
-        image::ImageReader::with_format(
-            std::io::Cursor::new(&bytes[..]),
-            image::ImageFormat::OpenExr,
-        )
-    };
-    let not_exr = |e: image::ImageError| {
-        bad(format!(
-            "expected an OpenEXR image of linear multipliers ({e})"
-        ))
-    };
-    let (w, h) = reader().into_dimensions().map_err(not_exr)?;
+    let exr = image::ImageFormat::OpenExr;
+    let not_exr = |r: decode::Refusal| bad(r.describe("an OpenEXR image of linear multipliers"));
+    let (_, w, h) = decode::header(&bytes, Some(exr)).map_err(not_exr)?;
     let side = crate::scene::limits::MAX_IMAGE_SIDE;
     if w == 0 || h == 0 || w > side || h > side {
         return Err(bad(format!(
             "expected width and height between 1 and {side}, got {w}x{h}"
         )));
     }
-    let rgb = reader().decode().map_err(not_exr)?.to_rgb32f();
+    let rgb = decode::decode(&bytes, exr, side, super::memory::available())
+        .map_err(not_exr)?
+        .to_rgb32f();
     Ok(AlbedoMap {
         width: rgb.width(),
         height: rgb.height(),

@@ -13,6 +13,8 @@ FAULTY_PIDDIR set leaves an empty file named after its pid there):
   noimage    succeed (exit 0 / ok: true) without writing the image
   garbage    write a file that is not an image
   wrongsize  write an image of the wrong size (8x6)
+  fifo       leave a FIFO (with no writer) where the image should be
+  devzero    leave a link to /dev/zero where the image should be
   refuse     worker: answer ok: false
   noise      worker: print non-protocol lines (and a JSON line with another
              id that is not an answer) around every answer, then render
@@ -69,6 +71,12 @@ def fault(mode, scene, out, renderer):
     if mode == "garbage":
         with open(out, "wb") as f:
             f.write(b"this is not a PNG file\n")
+        return True
+    if mode == "fifo":
+        os.mkfifo(out)
+        return True
+    if mode == "devzero":
+        os.symlink("/dev/zero", out)
         return True
     if mode == "wrongsize":
         renderer.write_png(out, 8, 6, [[128] * 24 for _ in range(6)])
