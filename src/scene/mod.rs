@@ -10,6 +10,7 @@ pub mod load;
 pub mod memory;
 pub mod nuisance;
 pub mod params;
+pub mod shape;
 #[cfg(test)]
 pub(crate) mod test_scene;
 pub mod types;
