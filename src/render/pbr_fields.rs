@@ -5,7 +5,8 @@
 //! Blinn-Phong lobes, `fresnel`, `specular2`) and any `falloff_power`
 //! (docs/renderers.md, "One material convention").
 //!
-//! Refused: a Mitsuba area light (`radius` > 0: a shape with an area
+//! Refused: an object's `transform` (the workers do not place shapes
+//! yet), a Mitsuba area light (`radius` > 0: a shape with an area
 //! emitter) with a falloff other than 1/d^2, and `fresnel` or `specular2` on a
 //! transmitting material (glass is drawn by the principled BSDF, with its
 //! own Fresnel term and one lobe), `albedo_map` (a map in the image's
@@ -37,6 +38,12 @@ pub fn check(scene: &Scene, backend: &str) -> Result<()> {
         }
     }
     for o in &scene.objects {
+        if o.transform.is_some() {
+            return refuse(
+                format!("objects.{}.transform", o.name),
+                "a placed object is drawn by phong only so far; use phong, or write the shape where it is",
+            );
+        }
         let m = &o.material;
         if m.albedo_map.is_some() {
             return refuse(
@@ -85,5 +92,22 @@ mod tests {
         }
         let e = crate::render::pov_sdl::check(&scene).unwrap_err();
         assert!(e.contains("material.diffuse_f90"), "{e}");
+    }
+
+    #[test]
+    fn a_transform_is_refused_by_every_other_backend_naming_the_field() {
+        let mut scene = crate::scene::test_scene::ball(r#""color": [0.5, 0.5, 0.5]"#, "");
+        assert!(check(&scene, "blender").is_ok());
+        assert!(crate::render::pov_sdl::check(&scene).is_ok());
+        scene.objects[0].transform = Some(crate::scene::Transform {
+            translate: Some([0.0, 0.1, 0.0]),
+            ..Default::default()
+        });
+        for backend in ["blender", "mitsuba"] {
+            let e = check(&scene, backend).unwrap_err().to_string();
+            assert!(e.contains("objects.ball.transform"), "{e}");
+        }
+        let e = crate::render::pov_sdl::check(&scene).unwrap_err();
+        assert!(e.contains("objects.ball.transform"), "{e}");
     }
 }

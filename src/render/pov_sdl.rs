@@ -24,7 +24,7 @@
 //! - objects: `sphere`, `plane`, `quad` (`polygon`), `box`.
 //! - names: never written (comments say `lights[i]`, `objects[i]`): the
 //!   SDL holds only numbers and fixed keywords, whatever a scene contains.
-//! - refused (a clear error): a directional light's `radius`, a material's
+//! - refused (a clear error): an object's `transform`, a directional light's `radius`, a material's
 //!   `fresnel` (other than 1), `diffuse_f90` (other than 1), `specular2` on glass, `albedo_map`. `indirect_light` (the
 //!   built-in tracer's estimate) is not used: `render.indirect` is POV-Ray's.
 //! - material (kd, ks, n, kr, kt, ior; T = min(kt, MAX_TRANSMIT)):
@@ -101,6 +101,12 @@ pub fn check(scene: &Scene) -> Result<(), String> {
         }
     }
     for o in &scene.objects {
+        if o.transform.is_some() {
+            return Err(format!(
+                "objects.{}.transform: a placed object is drawn by phong only so far; use phong, or write the shape where it is",
+                o.name
+            ));
+        }
         let m = &o.material;
         if m.albedo_map.is_some() {
             return Err(format!(

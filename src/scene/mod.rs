@@ -13,6 +13,7 @@ pub mod params;
 pub mod shape;
 #[cfg(test)]
 pub(crate) mod test_scene;
+pub mod transform;
 pub mod types;
 pub mod validate;
 

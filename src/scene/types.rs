@@ -5,6 +5,7 @@
 use serde::{Deserialize, Serialize};
 
 pub use super::shape::Shape;
+pub use super::transform::{Scale, Transform};
 
 pub type Vec3 = [f64; 3];
 
@@ -237,6 +238,9 @@ pub struct Object {
     pub name: String,
     pub shape: Shape,
     pub material: Material,
+    /// Where the shape is placed (absent: as written).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub transform: Option<Transform>,
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]

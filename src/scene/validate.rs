@@ -138,6 +138,9 @@ fn objects(scene: &Scene, file: &str) -> Result<()> {
             );
         }
         shape(&o.shape, file, &format!("{at}.shape"))?;
+        if let Some(t) = &o.transform {
+            transform(t, &o.shape, file, &format!("{at}.transform"))?;
+        }
         material(&o.material, file, &format!("{at}.material"))?;
     }
     Ok(())
@@ -428,6 +431,39 @@ fn shape(s: &Shape, file: &str, at: &str) -> Result<()> {
                     format!("expected every component above min {min:?}, got {max:?}"),
                 ));
             }
+            Ok(())
+        }
+    }
+}
+
+/// Finite numbers and positive scales; one scale for a sphere (a
+/// stretched sphere, an ellipsoid, is not drawn).
+fn transform(t: &Transform, s: &Shape, file: &str, at: &str) -> Result<()> {
+    for (k, v) in [("translate", t.translate), ("rotate_deg", t.rotate_deg)] {
+        if v.is_some_and(|v| !finite3(v)) {
+            return Err(Error::invalid(
+                file,
+                format!("{at}.{k}"),
+                "expected finite numbers",
+            ));
+        }
+    }
+    let Some(scale) = t.scale else {
+        return Ok(());
+    };
+    for x in scale.axes() {
+        positive(file, &format!("{at}.scale"), x)?;
+    }
+    match s {
+        Shape::Sphere { .. } if scale.uniform().is_none() => Err(Error::invalid(
+            file,
+            format!("{at}.scale"),
+            format!(
+                "a sphere takes one scale for every axis (an ellipsoid is not drawn); expected a number, got {:?}",
+                scale.axes()
+            ),
+        )),
+        Shape::Sphere { .. } | Shape::Plane { .. } | Shape::Quad { .. } | Shape::Box { .. } => {
             Ok(())
         }
     }
