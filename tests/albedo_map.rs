@@ -168,7 +168,12 @@ fn a_planted_map_is_accepted_first_on_a_set_and_frees_the_lights() {
     let result: Value =
         serde_json::from_str(&std::fs::read_to_string(dir.path().join("fit/result.json")).unwrap())
             .unwrap();
-    let centre = model.objects[0].shape.center.unwrap();
+    let centre: [f64; 3] = model.objects[0]
+        .shape
+        .field("center")
+        .unwrap()
+        .try_into()
+        .unwrap();
     let e0 = light_error(&result["shots"], "params", centre, &truth);
     let e1 = light_error(&d["shots_after"], "params", centre, &truth);
     println!("deviation {before:.3} -> {after:.3}; light error {e0:.2} -> {e1:.2} deg");

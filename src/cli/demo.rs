@@ -169,8 +169,8 @@ fn parameter_errors(
                         // Relative to the light's distance from the sphere.
                         let c = truth.objects[truth.object_index("sphere").unwrap_or(0)]
                             .shape
-                            .center
-                            .unwrap_or_default();
+                            .field("center")
+                            .unwrap_or(&[0.0; 3]);
                         let dist =
                             ((t[0] - c[0]).powi(2) + (t[1] - c[1]).powi(2) + (t[2] - c[2]).powi(2))
                                 .sqrt();

@@ -24,7 +24,7 @@
 //! - objects: `sphere`, `plane`, `quad` (`polygon`), `box`.
 //! - names: never written (comments say `lights[i]`, `objects[i]`): the
 //!   SDL holds only numbers and fixed keywords, whatever a scene contains.
-//! - refused (a clear error): a directional light's `radius`, a material's
+//! - refused (a clear error): an object's `transform`, a directional light's `radius`, a material's
 //!   `fresnel` (other than 1), `diffuse_f90` (other than 1), `specular2` on glass, `albedo_map`. `indirect_light` (the
 //!   built-in tracer's estimate) is not used: `render.indirect` is POV-Ray's.
 //! - material (kd, ks, n, kr, kt, ior; T = min(kt, MAX_TRANSMIT)):
@@ -39,7 +39,7 @@
 //!   bottom finish).
 
 use super::backend::Refusal;
-use crate::scene::{CameraKind, Falloff, LightKind, Material, Scene, ShapeKind, Vec3};
+use crate::scene::{CameraKind, Falloff, LightKind, Material, Scene, Shape, Vec3};
 use std::f64::consts::PI;
 use std::fmt::Write;
 
@@ -106,6 +106,12 @@ pub fn refusals(scene: &Scene) -> Vec<Refusal> {
         }
     }
     for o in &scene.objects {
+        if o.transform.is_some() {
+            out.push(Refusal::new(
+                format!("objects.{}.transform", o.name),
+                "a placed object is drawn by phong only so far; use phong, or write the shape where it is",
+            ));
+        }
         let m = &o.material;
         if m.albedo_map.is_some() {
             out.push(Refusal::new(
@@ -184,42 +190,36 @@ pub fn sdl(scene: &Scene) -> Result<String, String> {
         light(&mut s, i, l)?;
     }
     for (i, o) in scene.objects.iter().enumerate() {
-        let sh = &o.shape;
-        let missing = || {
-            format!(
-                "objects.{}.shape: incomplete (the scene was not validated)",
-                o.name
-            )
-        };
-        let shape = match sh.kind {
-            ShapeKind::Sphere => format!(
-                "sphere {{ {}, {}",
-                vec(pov(sh.center.ok_or_else(missing)?)),
-                num(sh.radius.ok_or_else(missing)?)
-            ),
-            ShapeKind::Plane => {
-                let n = normalized(pov(sh.normal.ok_or_else(missing)?)).ok_or_else(missing)?;
-                let p = pov(sh.point.ok_or_else(missing)?);
-                format!("plane {{ {}, {}", vec(n), num(dot(n, p)))
+        let shape = match o.shape {
+            Shape::Sphere { center, radius } => {
+                format!("sphere {{ {}, {}", vec(pov(center)), num(radius))
             }
-            ShapeKind::Quad => {
-                let c = pov(sh.corner.ok_or_else(missing)?);
-                let u = pov(sh.edge_u.ok_or_else(missing)?);
-                let v = pov(sh.edge_v.ok_or_else(missing)?);
+            Shape::Plane { point, normal } => {
+                let n = normalized(pov(normal)).ok_or_else(|| {
+                    format!(
+                        "objects.{}.shape.normal: expected a non-zero vector",
+                        o.name
+                    )
+                })?;
+                format!("plane {{ {}, {}", vec(n), num(dot(n, pov(point))))
+            }
+            Shape::Quad {
+                corner,
+                edge_u,
+                edge_v,
+            } => {
+                let (c, u, v) = (pov(corner), pov(edge_u), pov(edge_v));
                 let p = [c, add(c, u), add(add(c, u), v), add(c, v), c];
                 format!(
                     "polygon {{ 5, {}",
                     p.iter().map(|x| vec(*x)).collect::<Vec<_>>().join(", ")
                 )
             }
-            ShapeKind::Box => {
-                let (lo, hi) = (sh.min.ok_or_else(missing)?, sh.max.ok_or_else(missing)?);
-                format!(
-                    "box {{ {}, {}",
-                    vec([lo[0], lo[1], -hi[2]]),
-                    vec([hi[0], hi[1], -lo[2]])
-                )
-            }
+            Shape::Box { min: lo, max: hi } => format!(
+                "box {{ {}, {}",
+                vec([lo[0], lo[1], -hi[2]]),
+                vec([hi[0], hi[1], -lo[2]])
+            ),
         };
         // names are never written: the SDL holds only numbers and keywords
         let _ = writeln!(

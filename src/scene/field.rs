@@ -17,7 +17,8 @@ pub enum Field {
     IndirectLight,
     Light(usize, LightField),
     Material(usize, MaterialField),
-    Shape(usize, ShapeField),
+    /// A shape's numeric field, by its name in the shape (`Shape::fields`).
+    Shape(usize, &'static str),
     Camera(CameraField),
 }
 
@@ -45,19 +46,6 @@ pub enum MaterialField {
     Specular2,
     Shininess2,
     DiffuseF90,
-}
-
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum ShapeField {
-    Center,
-    Radius,
-    Point,
-    Normal,
-    Corner,
-    EdgeU,
-    EdgeV,
-    Min,
-    Max,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -148,20 +136,10 @@ impl Field {
                     MaterialField::DiffuseF90 => Scalar(m.diffuse_f90?),
                 }
             }
-            Field::Shape(i, f) => {
-                let s = &scene.objects[i].shape;
-                match f {
-                    ShapeField::Center => Vector(s.center?),
-                    ShapeField::Radius => Scalar(s.radius?),
-                    ShapeField::Point => Vector(s.point?),
-                    ShapeField::Normal => Vector(s.normal?),
-                    ShapeField::Corner => Vector(s.corner?),
-                    ShapeField::EdgeU => Vector(s.edge_u?),
-                    ShapeField::EdgeV => Vector(s.edge_v?),
-                    ShapeField::Min => Vector(s.min?),
-                    ShapeField::Max => Vector(s.max?),
-                }
-            }
+            Field::Shape(i, f) => match scene.objects[i].shape.field(f)? {
+                [x] => Scalar(*x),
+                v => Vector(v.try_into().ok()?),
+            },
             Field::Camera(f) => {
                 let c = &scene.camera;
                 match f {
@@ -205,7 +183,7 @@ impl Field {
             Field::Material(i, f) => {
                 format!("objects.{}.material.{}", scene.objects[i].name, f.key())
             }
-            Field::Shape(i, f) => format!("objects.{}.shape.{}", scene.objects[i].name, f.key()),
+            Field::Shape(i, f) => format!("objects.{}.shape.{f}", scene.objects[i].name),
             Field::Camera(f) => format!("camera.{}", f.key()),
         }
     }
@@ -282,22 +260,6 @@ impl MaterialField {
             MaterialField::Specular2 => "specular2",
             MaterialField::Shininess2 => "shininess2",
             MaterialField::DiffuseF90 => "diffuse_f90",
-        }
-    }
-}
-
-impl ShapeField {
-    fn key(self) -> &'static str {
-        match self {
-            ShapeField::Center => "center",
-            ShapeField::Radius => "radius",
-            ShapeField::Point => "point",
-            ShapeField::Normal => "normal",
-            ShapeField::Corner => "corner",
-            ShapeField::EdgeU => "edge_u",
-            ShapeField::EdgeV => "edge_v",
-            ShapeField::Min => "min",
-            ShapeField::Max => "max",
         }
     }
 }
@@ -384,30 +346,19 @@ fn material_field(scene: &Scene, name: &str, field: &str, path: &str) -> Result<
     Ok(Field::Material(i, f))
 }
 
-/// `objects.NAME.shape.FIELD`, when the shape kind has it.
+/// `objects.NAME.shape.FIELD`, when the object's shape has that field.
 fn shape_field(scene: &Scene, name: &str, field: &str) -> Result<Field, String> {
     let i = object(scene, name)?;
-    let f = match field {
-        "center" => ShapeField::Center,
-        "radius" => ShapeField::Radius,
-        "point" => ShapeField::Point,
-        "normal" => ShapeField::Normal,
-        "corner" => ShapeField::Corner,
-        "edge_u" => ShapeField::EdgeU,
-        "edge_v" => ShapeField::EdgeV,
-        "min" => ShapeField::Min,
-        "max" => ShapeField::Max,
-        other => return Err(format!("a shape has no numeric field \"{other}\"")),
-    };
-    let resolved = Field::Shape(i, f);
-    if resolved.get(scene).is_none() {
-        return Err(format!(
-            "object \"{name}\" is a {:?} and has no \"{}\"",
-            scene.objects[i].shape.kind, field
-        )
-        .to_lowercase());
+    let shape = &scene.objects[i].shape;
+    let names = shape.field_names();
+    match names.iter().find(|k| **k == field) {
+        Some(k) => Ok(Field::Shape(i, k)),
+        None => Err(format!(
+            "object \"{name}\" is a {} and has no numeric field \"{field}\" (expected {})",
+            shape.type_name(),
+            names.join(" or ")
+        )),
     }
-    Ok(resolved)
 }
 
 /// `camera.FIELD`, when the camera model has it.
@@ -501,17 +452,11 @@ fn set_material(m: &mut super::types::Material, f: MaterialField, value: Value) 
     }
 }
 
-fn set_shape(sh: &mut super::types::Shape, f: ShapeField, value: Value) {
-    match f {
-        ShapeField::Center => ov(&mut sh.center, value),
-        ShapeField::Radius => os(&mut sh.radius, value),
-        ShapeField::Point => ov(&mut sh.point, value),
-        ShapeField::Normal => ov(&mut sh.normal, value),
-        ShapeField::Corner => ov(&mut sh.corner, value),
-        ShapeField::EdgeU => ov(&mut sh.edge_u, value),
-        ShapeField::EdgeV => ov(&mut sh.edge_v, value),
-        ShapeField::Min => ov(&mut sh.min, value),
-        ShapeField::Max => ov(&mut sh.max, value),
+fn set_shape(sh: &mut super::types::Shape, name: &str, value: Value) {
+    match (sh.field_mut(name), value) {
+        (Some([slot]), Value::Scalar(x)) => *slot = x,
+        (Some(slot), Value::Vector(x)) if slot.len() == 3 => slot.copy_from_slice(&x),
+        _ => {}
     }
 }
 

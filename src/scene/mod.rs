@@ -10,8 +10,10 @@ pub mod load;
 pub mod memory;
 pub mod nuisance;
 pub mod params;
+pub mod shape;
 #[cfg(test)]
 pub(crate) mod test_scene;
+pub mod transform;
 pub mod types;
 pub mod validate;
 

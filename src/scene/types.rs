@@ -4,6 +4,9 @@
 
 use serde::{Deserialize, Serialize};
 
+pub use super::shape::Shape;
+pub use super::transform::{Scale, Transform};
+
 pub type Vec3 = [f64; 3];
 
 /// The format tag every scene file carries.
@@ -235,43 +238,9 @@ pub struct Object {
     pub name: String,
     pub shape: Shape,
     pub material: Material,
-}
-
-#[derive(Clone, Copy, Debug, Serialize, Deserialize, PartialEq, Eq)]
-#[serde(rename_all = "lowercase")]
-pub enum ShapeKind {
-    Sphere,
-    Plane,
-    Quad,
-    Box,
-}
-
-/// One struct for every shape kind; `validate` checks which fields each
-/// kind needs (sphere: center, radius; plane: point, normal; quad: corner,
-/// edge_u, edge_v; box: min, max).
-#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
-#[serde(deny_unknown_fields)]
-pub struct Shape {
-    #[serde(rename = "type")]
-    pub kind: ShapeKind,
+    /// Where the shape is placed (absent: as written).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub center: Option<Vec3>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub radius: Option<f64>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub point: Option<Vec3>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub normal: Option<Vec3>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub corner: Option<Vec3>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub edge_u: Option<Vec3>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub edge_v: Option<Vec3>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub min: Option<Vec3>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub max: Option<Vec3>,
+    pub transform: Option<Transform>,
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]

@@ -138,6 +138,9 @@ fn objects(scene: &Scene, file: &str) -> Result<()> {
             );
         }
         shape(&o.shape, file, &format!("{at}.shape"))?;
+        if let Some(t) = &o.transform {
+            transform(t, &o.shape, file, &format!("{at}.transform"))?;
+        }
         material(&o.material, file, &format!("{at}.material"))?;
     }
     Ok(())
@@ -383,65 +386,33 @@ fn light(l: &Light, file: &str, at: &str) -> Result<()> {
     }
 }
 
+/// A shape's values; which fields it has the types already decide.
 fn shape(s: &Shape, file: &str, at: &str) -> Result<()> {
     let key = |k: &str| format!("{at}.{k}");
-    let all: [(&str, bool); 9] = [
-        ("center", s.center.is_some()),
-        ("radius", s.radius.is_some()),
-        ("point", s.point.is_some()),
-        ("normal", s.normal.is_some()),
-        ("corner", s.corner.is_some()),
-        ("edge_u", s.edge_u.is_some()),
-        ("edge_v", s.edge_v.is_some()),
-        ("min", s.min.is_some()),
-        ("max", s.max.is_some()),
-    ];
-    let (kind, wanted): (&str, &[&str]) = match s.kind {
-        ShapeKind::Sphere => ("a sphere", &["center", "radius"]),
-        ShapeKind::Plane => ("a plane", &["point", "normal"]),
-        ShapeKind::Quad => ("a quad", &["corner", "edge_u", "edge_v"]),
-        ShapeKind::Box => ("a box", &["min", "max"]),
+    let finite = |k: &str, v: Vec3| -> Result<()> {
+        if !finite3(v) {
+            return Err(Error::invalid(file, key(k), "expected finite numbers"));
+        }
+        Ok(())
     };
-    for (name, present) in all {
-        let needed = wanted.contains(&name);
-        if needed && !present {
-            return Err(Error::invalid(
-                file,
-                key(name),
-                format!("missing; {kind} needs {}", wanted.join(", ")),
-            ));
+    match *s {
+        Shape::Sphere { center, radius } => {
+            finite("center", center)?;
+            positive(file, &key("radius"), radius)
         }
-        if !needed && present {
-            return Err(Error::invalid(
-                file,
-                key(name),
-                format!("not used by {kind} (it takes {})", wanted.join(", ")),
-            ));
+        Shape::Plane { point, normal } => {
+            finite("point", point)?;
+            nonzero3(file, &key("normal"), normal)
         }
-    }
-    let finite = |k: &str, v: Option<Vec3>| -> Result<()> {
-        match v {
-            Some(v) if !finite3(v) => Err(Error::invalid(file, key(k), "expected finite numbers")),
-            _ => Ok(()),
-        }
-    };
-    for (k, v) in [
-        ("center", s.center),
-        ("point", s.point),
-        ("corner", s.corner),
-        ("min", s.min),
-        ("max", s.max),
-    ] {
-        finite(k, v)?;
-    }
-    match s.kind {
-        ShapeKind::Sphere => positive(file, &key("radius"), s.radius.unwrap_or(0.0)),
-        ShapeKind::Plane => nonzero3(file, &key("normal"), s.normal.unwrap_or_default()),
-        ShapeKind::Quad => {
-            let (u, v) = (s.edge_u.unwrap_or_default(), s.edge_v.unwrap_or_default());
-            nonzero3(file, &key("edge_u"), u)?;
-            nonzero3(file, &key("edge_v"), v)?;
-            if V3::from(u).cross(V3::from(v)).length() < 1e-12 {
+        Shape::Quad {
+            corner,
+            edge_u,
+            edge_v,
+        } => {
+            finite("corner", corner)?;
+            nonzero3(file, &key("edge_u"), edge_u)?;
+            nonzero3(file, &key("edge_v"), edge_v)?;
+            if V3::from(edge_u).cross(V3::from(edge_v)).length() < 1e-12 {
                 return Err(Error::invalid(
                     file,
                     key("edge_v"),
@@ -450,15 +421,49 @@ fn shape(s: &Shape, file: &str, at: &str) -> Result<()> {
             }
             Ok(())
         }
-        ShapeKind::Box => {
-            let (lo, hi) = (s.min.unwrap_or_default(), s.max.unwrap_or_default());
-            if (0..3).any(|a| lo[a] >= hi[a]) {
+        Shape::Box { min, max } => {
+            finite("min", min)?;
+            finite("max", max)?;
+            if (0..3).any(|a| min[a] >= max[a]) {
                 return Err(Error::invalid(
                     file,
                     key("max"),
-                    format!("expected every component above min {lo:?}, got {hi:?}"),
+                    format!("expected every component above min {min:?}, got {max:?}"),
                 ));
             }
+            Ok(())
+        }
+    }
+}
+
+/// Finite numbers and positive scales; one scale for a sphere (a
+/// stretched sphere, an ellipsoid, is not drawn).
+fn transform(t: &Transform, s: &Shape, file: &str, at: &str) -> Result<()> {
+    for (k, v) in [("translate", t.translate), ("rotate_deg", t.rotate_deg)] {
+        if v.is_some_and(|v| !finite3(v)) {
+            return Err(Error::invalid(
+                file,
+                format!("{at}.{k}"),
+                "expected finite numbers",
+            ));
+        }
+    }
+    let Some(scale) = t.scale else {
+        return Ok(());
+    };
+    for x in scale.axes() {
+        positive(file, &format!("{at}.scale"), x)?;
+    }
+    match s {
+        Shape::Sphere { .. } if scale.uniform().is_none() => Err(Error::invalid(
+            file,
+            format!("{at}.scale"),
+            format!(
+                "a sphere takes one scale for every axis (an ellipsoid is not drawn); expected a number, got {:?}",
+                scale.axes()
+            ),
+        )),
+        Shape::Sphere { .. } | Shape::Plane { .. } | Shape::Quad { .. } | Shape::Box { .. } => {
             Ok(())
         }
     }

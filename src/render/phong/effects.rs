@@ -6,7 +6,7 @@
 //! inter-reflection estimate from virtual point lights (Keller, "Instant
 //! Radiosity", SIGGRAPH 1997), without visibility.
 
-use super::geometry::{Geometry, Prim};
+use super::geometry::{Geometry, Intersect, Prim};
 use super::packed::Packed;
 use crate::math::V3;
 

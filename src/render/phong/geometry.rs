@@ -1,10 +1,15 @@
-//! Ray intersection for the built-in tracer: spheres, infinite planes and
-//! parallelograms (quads); a box is six quads. Every primitive remembers the
-//! scene object it belongs to.
+//! The built-in tracer's primitives, made from the scene's shapes: spheres,
+//! infinite planes and parallelograms (quads); a box is six quads. Every
+//! primitive remembers the scene object it belongs to. How a ray meets
+//! each is its `Intersect` implementation; which ones a ray is tested
+//! against is the `Accel`'s business (`accel.rs`).
 
+pub use super::accel::Intersect;
+use super::accel::{Aabb, Accel};
 use super::camera::CameraRays;
 use crate::math::V3;
-use crate::scene::{Scene, ShapeKind};
+use crate::scene::transform::Affine;
+use crate::scene::{Scene, Shape};
 use std::ops::Range;
 
 /// An axis-aligned rectangle of image points, in pixels.
@@ -91,6 +96,7 @@ pub enum Occluder {
 pub struct Geometry {
     pub prims: Vec<Prim>,
     pub owner: Vec<u32>,
+    accel: Accel,
 }
 
 impl Geometry {
@@ -98,32 +104,28 @@ impl Geometry {
         let mut prims = Vec::new();
         let mut owner = Vec::new();
         for (i, obj) in scene.objects.iter().enumerate() {
-            let s = &obj.shape;
+            let first = prims.len();
             let mut add = |p: Prim| {
                 prims.push(p);
                 owner.push(i as u32);
             };
-            match s.kind {
-                ShapeKind::Sphere => {
-                    let r = s.radius.unwrap_or(1.0);
-                    add(Prim::Sphere {
-                        c: V3::from(s.center.unwrap_or_default()),
-                        r2: r * r,
-                    });
-                }
-                ShapeKind::Plane => add(Prim::Plane {
-                    p: V3::from(s.point.unwrap_or_default()),
-                    n: V3::from(s.normal.unwrap_or([0.0, 1.0, 0.0])).normalized(),
+            match obj.shape {
+                Shape::Sphere { center, radius } => add(Prim::Sphere {
+                    c: V3::from(center),
+                    r2: radius * radius,
                 }),
-                ShapeKind::Quad => add(quad(
-                    V3::from(s.corner.unwrap_or_default()),
-                    V3::from(s.edge_u.unwrap_or([1.0, 0.0, 0.0])),
-                    V3::from(s.edge_v.unwrap_or([0.0, 0.0, 1.0])),
-                )),
-                ShapeKind::Box => {
-                    let lo = V3::from(s.min.unwrap_or_default());
-                    let hi = V3::from(s.max.unwrap_or([1.0; 3]));
-                    let d = hi - lo;
+                Shape::Plane { point, normal } => add(Prim::Plane {
+                    p: V3::from(point),
+                    n: V3::from(normal).normalized(),
+                }),
+                Shape::Quad {
+                    corner,
+                    edge_u,
+                    edge_v,
+                } => add(quad(V3::from(corner), V3::from(edge_u), V3::from(edge_v))),
+                Shape::Box { min, max } => {
+                    let lo = V3::from(min);
+                    let d = V3::from(max) - lo;
                     let (ex, ey, ez) = (
                         V3::new(d.x, 0.0, 0.0),
                         V3::new(0.0, d.y, 0.0),
@@ -137,8 +139,19 @@ impl Geometry {
                     add(quad(lo + ey, ez, ex));
                 }
             }
+            if let Some(t) = &obj.transform {
+                let a = Affine::new(t);
+                for p in &mut prims[first..] {
+                    *p = placed(p, &a);
+                }
+            }
         }
-        Geometry { prims, owner }
+        let accel = Accel::new(&prims);
+        Geometry {
+            prims,
+            owner,
+            accel,
+        }
     }
 
     /// The nearest hit along the ray within (EPS, t_max).
@@ -149,22 +162,20 @@ impl Geometry {
     /// The nearest hit within (EPS, t_max) among the primitives `tested` keeps.
     #[inline(always)]
     fn nearest(&self, o: V3, d: V3, t_max: f64, tested: impl Fn(usize) -> bool) -> Option<Hit> {
-        let mut best: Option<Hit> = None;
-        let mut t_best = t_max;
-        for (i, prim) in self.prims.iter().enumerate() {
-            if !tested(i) {
-                continue;
-            }
-            if let Some((t, n)) = prim.intersect(o, d, t_best) {
-                t_best = t;
-                best = Some(Hit {
-                    t,
-                    n,
-                    object: self.owner[i],
-                });
-            }
-        }
-        best
+        let (i, t, n) = self.accel.nearest(&self.prims, o, d, t_max, tested)?;
+        Some(Hit {
+            t,
+            n,
+            object: self.owner[i],
+        })
+    }
+
+    /// True when a primitive of another object than `object` lies on the
+    /// segment from `o` along `d` within (EPS, t_max): our shapes are
+    /// convex, so an object never shadows itself.
+    pub fn blocked_by_others(&self, o: V3, d: V3, t_max: f64, object: u32) -> bool {
+        self.accel
+            .any(&self.prims, o, d, t_max, |i| self.owner[i] != object)
     }
 
     /// For each primitive, the pixel rectangle its image lies in, when one
@@ -177,12 +188,8 @@ impl Geometry {
             .iter()
             .map(|prim| {
                 let corners: Vec<V3> = match *prim {
-                    Prim::Sphere { c, r2 } => {
-                        let r = V3::new(1.0, 1.0, 1.0) * r2.sqrt();
-                        corners(c - r, c + r).to_vec()
-                    }
                     Prim::Quad { o, u, v, .. } => vec![o, o + u, o + v, o + u + v],
-                    Prim::Plane { .. } => return None,
+                    Prim::Sphere { .. } | Prim::Plane { .. } => prim.bounds()?.corners().to_vec(),
                 };
                 let mut rect = Rect::EMPTY;
                 for k in corners {
@@ -272,6 +279,27 @@ impl Geometry {
     }
 }
 
+/// `p` moved by `a`, exactly: an affine map takes a parallelogram to a
+/// parallelogram and a plane to a plane, and a sphere (whose scale is
+/// uniform, `validate.rs`) to a sphere.
+fn placed(p: &Prim, a: &Affine) -> Prim {
+    match *p {
+        Prim::Sphere { c, r2 } => {
+            // |m x| / |x| for any x: the one scale factor.
+            let s = a.vector(V3::new(1.0, 0.0, 0.0)).length();
+            Prim::Sphere {
+                c: a.point(c),
+                r2: r2 * s * s,
+            }
+        }
+        Prim::Plane { p, n } => Prim::Plane {
+            p: a.point(p),
+            n: a.normal(n).normalized(),
+        },
+        Prim::Quad { o, u, v, .. } => quad(a.point(o), a.vector(u), a.vector(v)),
+    }
+}
+
 fn quad(o: V3, u: V3, v: V3) -> Prim {
     let c = u.cross(v);
     Prim::Quad {
@@ -297,10 +325,9 @@ fn sphere_roots(o: V3, d: V3, c: V3, r2: f64) -> Option<(f64, f64)> {
     Some((-b - sq, -b + sq))
 }
 
-impl Prim {
-    /// Distance and unit normal of the nearest hit in (EPS, t_max).
+impl Intersect for Prim {
     #[inline]
-    pub fn intersect(&self, o: V3, d: V3, t_max: f64) -> Option<(f64, V3)> {
+    fn hit(&self, o: V3, d: V3, t_max: f64) -> Option<(f64, V3)> {
         match *self {
             Prim::Sphere { c, r2 } => {
                 let (t0, t1) = sphere_roots(o, d, c, r2)?;
@@ -336,36 +363,50 @@ impl Prim {
         }
     }
 
-    /// Shadow-ray test: any hit in (EPS, t_max)?
     #[inline]
-    pub fn hits_before(&self, o: V3, d: V3, t_max: f64) -> bool {
+    fn hits_before(&self, o: V3, d: V3, t_max: f64) -> bool {
         match *self {
             Prim::Sphere { c, r2 } => sphere_roots(o, d, c, r2)
                 .is_some_and(|(t0, t1)| (t0 > EPS && t0 < t_max) || (t1 > EPS && t1 < t_max)),
-            _ => self.intersect(o, d, t_max).is_some(),
+            Prim::Plane { .. } | Prim::Quad { .. } => self.hit(o, d, t_max).is_some(),
         }
     }
 
-    /// A conservative test: could this primitive block any segment from `p`
-    /// to a point of the axis-aligned box [lo, hi]? False only when it
-    /// certainly cannot.
-    pub fn may_block(&self, p: V3, lo: V3, hi: V3) -> bool {
+    fn bounds(&self) -> Option<Aabb> {
         match *self {
             Prim::Sphere { c, r2 } => {
-                // The segments lie in the bounding box of p and [lo, hi].
                 let r = r2.sqrt();
-                (0..3).all(|a| {
-                    let (bl, bh) = (p.get(a).min(lo.get(a)), p.get(a).max(hi.get(a)));
-                    c.get(a) + r >= bl && c.get(a) - r <= bh
+                let r = V3::new(r, r, r);
+                Some(Aabb {
+                    lo: c - r,
+                    hi: c + r,
                 })
             }
+            Prim::Quad { o, u, v, .. } => {
+                let mut b = Aabb { lo: o, hi: o };
+                for k in [o + u, o + v, o + u + v] {
+                    b = Aabb::hull(k, b.lo, b.hi);
+                }
+                Some(b)
+            }
+            Prim::Plane { .. } => None,
+        }
+    }
+
+    fn may_block(&self, p: V3, lo: V3, hi: V3) -> bool {
+        match *self {
+            // The segments lie in the bounding box of p and [lo, hi].
+            Prim::Sphere { .. } => self
+                .bounds()
+                .is_none_or(|b| b.overlaps(&Aabb::hull(p, lo, hi))),
             Prim::Plane { p: q, n } | Prim::Quad { o: q, n, .. } => {
                 // A segment crosses the plane only if its ends are on opposite sides.
                 let side_p = (p - q).dot(n);
                 if side_p.abs() < 1e-9 {
                     return false; // p lies on the plane: the segment leaves it at once
                 }
-                corners(lo, hi)
+                Aabb { lo, hi }
+                    .corners()
                     .iter()
                     .any(|&k| (k - q).dot(n) * side_p <= 0.0)
             }
@@ -373,14 +414,70 @@ impl Prim {
     }
 }
 
-fn corners(lo: V3, hi: V3) -> [V3; 8] {
-    let mut out = [lo; 8];
-    for (i, k) in out.iter_mut().enumerate() {
-        *k = V3::new(
-            if i & 1 == 0 { lo.x } else { hi.x },
-            if i & 2 == 0 { lo.y } else { hi.y },
-            if i & 4 == 0 { lo.z } else { hi.z },
-        );
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The ball scene with one object: `shape` (JSON) placed by
+    /// `transform` (JSON, or "" for none).
+    fn one(shape: &str, transform: &str) -> Geometry {
+        let mut scene = crate::scene::test_scene::ball(r#""color": [0.5, 0.5, 0.5]"#, "");
+        scene.objects[0].shape = serde_json::from_str(shape).unwrap();
+        scene.objects[0].transform =
+            (!transform.is_empty()).then(|| serde_json::from_str(transform).unwrap());
+        Geometry::new(&scene)
     }
-    out
+
+    /// A shape placed by a transform is hit where the same shape written
+    /// in place is: every ray of a grid through the scene meets both or
+    /// neither, at the same distance.
+    #[test]
+    fn a_placed_shape_is_hit_where_it_is_written() {
+        let cases = [
+            (
+                r#"{"type": "sphere", "center": [0, 0.5, 0], "radius": 0.5}"#,
+                r#"{"type": "sphere", "center": [0, 0, 0], "radius": 0.25}"#,
+                r#"{"scale": 2, "rotate_deg": [10, 20, 30], "translate": [0, 0.5, 0]}"#,
+            ),
+            (
+                r#"{"type": "box", "min": [-1, 0, -0.25], "max": [1, 1, 0.25]}"#,
+                r#"{"type": "box", "min": [-0.5, -0.5, -0.5], "max": [0.5, 0.5, 0.5]}"#,
+                r#"{"scale": [2, 1, 0.5], "translate": [0, 0.5, 0]}"#,
+            ),
+            (
+                // about y by 90: +x goes to -z, +z to +x
+                r#"{"type": "quad", "corner": [0.2, 0, 0], "edge_u": [0, 0, -1], "edge_v": [0.5, 0.7, 0]}"#,
+                r#"{"type": "quad", "corner": [0, 0, 0], "edge_u": [1, 0, 0], "edge_v": [0, 0.7, 0.5]}"#,
+                r#"{"rotate_deg": [0, 90, 0], "translate": [0.2, 0, 0]}"#,
+            ),
+            (
+                // a stretched tilted plane: its normal by the inverse scale
+                r#"{"type": "plane", "point": [0, 0.2, 0], "normal": [0.5, 1, 0]}"#,
+                r#"{"type": "plane", "point": [0, 0.2, 0], "normal": [1, 1, 0]}"#,
+                r#"{"scale": [2, 1, 1]}"#,
+            ),
+        ];
+        for (written, shape, transform) in cases {
+            let (a, b) = (one(written, ""), one(shape, transform));
+            let mut hits = 0;
+            // Off-grid steps, so that no ray grazes an edge, where the
+            // last bit decides.
+            for i in 0..400 {
+                let (x, y) = (
+                    (i % 20) as f64 * 0.1037 - 1.01,
+                    (i / 20) as f64 * 0.0971 - 0.49,
+                );
+                let o = V3::new(0.313, 1.517, 5.0);
+                let d = (V3::new(x, y, 0.0) - o).normalized();
+                let (ha, hb) = (a.intersect(o, d, 1e9), b.intersect(o, d, 1e9));
+                assert_eq!(ha.is_some(), hb.is_some(), "{shape} {transform}: ray {i}");
+                if let (Some(ha), Some(hb)) = (ha, hb) {
+                    assert!((ha.t - hb.t).abs() < 1e-9, "{shape}: {} vs {}", ha.t, hb.t);
+                    assert!((ha.n.dot(hb.n).abs() - 1.0).abs() < 1e-9, "{shape}");
+                    hits += 1;
+                }
+            }
+            assert!(hits > 5, "{shape}: {hits} hits");
+        }
+    }
 }

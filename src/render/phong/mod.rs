@@ -15,6 +15,7 @@
 //! A batch renders its candidates in parallel; each render is sequential and
 //! deterministic.
 
+mod accel;
 mod bounce;
 mod camera;
 mod effects;

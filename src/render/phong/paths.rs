@@ -5,7 +5,7 @@
 //! free; built per candidate when a free parameter moves geometry.
 
 use super::camera::CameraRays;
-use super::geometry::{Geometry, Hit, Occluder, EPS};
+use super::geometry::{Geometry, Hit, Intersect, Occluder, EPS};
 use crate::math::V3;
 use crate::scene::field::{LightField, MaterialField};
 use crate::scene::{Field, LightKind, ParamSpace, Scene};
@@ -299,10 +299,7 @@ impl Tracer<'_> {
         if let Some((d, dist)) = fixed {
             // A light that does not move: decide once.
             let o = p + n * EPS * 10.0;
-            let lit = n.dot(d) > 0.0
-                && !(0..g.prims.len())
-                    .filter(others)
-                    .any(|i| g.prims[i].hits_before(o, d, dist));
+            let lit = n.dot(d) > 0.0 && !g.blocked_by_others(o, d, dist, object);
             return if lit { Shadow::Lit } else { Shadow::Dark };
         }
         let bounds = match self.var.lights[l] {
@@ -368,7 +365,11 @@ mod tests {
         let mut beside = example("sphere_floor.json");
         let cam = V3::from(beside.camera.position);
         let c = cam + V3::new(0.6, 0.0, 0.0);
-        beside.objects[0].shape.center = Some([c.x, c.y, c.z]);
+        beside.objects[0]
+            .shape
+            .field_mut("center")
+            .unwrap()
+            .copy_from_slice(&[c.x, c.y, c.z]);
         for scene in [
             example("sphere_floor.json"),
             example("paper_box.json"),
