@@ -2,6 +2,9 @@
 
 use std::ops::{Add, AddAssign, Div, Mul, Neg, Sub};
 
+/// A 3-vector as the scene file writes it: `[x, y, z]`.
+pub type Vec3 = [f64; 3];
+
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct V3 {
     pub x: f64,

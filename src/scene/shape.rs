@@ -5,7 +5,7 @@
 //! geometry, the POV-Ray writer). Free parameters reach a shape's numbers
 //! by field name through [`Shape::fields`] and [`Shape::fields_mut`].
 
-use super::types::Vec3;
+use crate::math::Vec3;
 use serde::{Deserialize, Serialize};
 
 /// A surface. Every field is required; unknown fields are refused.

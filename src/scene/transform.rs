@@ -4,7 +4,7 @@
 //! about the world x, then y, then z axis (right-handed, degrees), then
 //! translated. The built-in tracer draws it; other backends refuse it.
 
-use super::types::Vec3;
+use crate::math::Vec3;
 use crate::math::V3;
 use serde::{Deserialize, Serialize};
 

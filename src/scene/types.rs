@@ -7,7 +7,7 @@ use serde::{Deserialize, Serialize};
 pub use super::shape::Shape;
 pub use super::transform::{Scale, Transform};
 
-pub type Vec3 = [f64; 3];
+pub use crate::math::Vec3;
 
 /// The format tag every scene file carries.
 pub const FORMAT: &str = "scenefit-scene/1";
