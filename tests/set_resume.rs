@@ -150,7 +150,10 @@ fn a_set_fit_killed_at_random_moments_resumes_to_the_same_result() {
     let mut moments = Moments(seed);
     let killed = d.path().join("killed");
     let mut kills = 0;
-    for _ in 0..6 {
+    for _ in 0..8 {
+        if killed.join("result.json").exists() {
+            break;
+        }
         let mut a = args("killed");
         // Killed before its first save, the directory holds nothing to
         // resume: the run starts afresh, as the refusal advises.
@@ -163,14 +166,15 @@ fn a_set_fit_killed_at_random_moments_resumes_to_the_same_result() {
             .stderr(std::process::Stdio::null())
             .spawn()
             .unwrap();
-        std::thread::sleep(Duration::from_millis(20 + moments.below(run_ms / 2)));
+        // At most a third of a run: every run but the last is killed.
+        std::thread::sleep(Duration::from_millis(20 + moments.below(run_ms / 3)));
         if child.try_wait().unwrap().is_none() {
             kills += 1;
         }
         child.kill().unwrap();
         child.wait().unwrap();
     }
-    assert!(kills >= 3, "only {kills} runs were killed before their end");
+    assert!(kills >= 2, "only {kills} runs were killed before their end");
     let mut a = args("killed");
     if killed.join("set_state.json").exists() {
         a.push("--resume".into());

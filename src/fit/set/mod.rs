@@ -128,6 +128,9 @@ pub fn run(
             run_dir.refuse_overwritten_input(m, &format!("shot {}'s mask", s.name))?;
         }
     }
+    for (what, p) in &config.fit.inputs {
+        run_dir.refuse_overwritten_input(p, what)?;
+    }
     run_in(scene, shots, renderer, config, Some(&run_dir), observer)
 }
 

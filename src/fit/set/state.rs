@@ -197,7 +197,7 @@ fn check_within(
     shared: usize,
 ) -> std::result::Result<(), (&'static str, &'static str)> {
     let w = &s.within;
-    let parts_ok = w.own_parts.len() < shots.max(1)
+    let parts_ok = w.own_parts.len() <= shots
         && w.own_parts
             .iter()
             .all(|p| p.len() == 4 && p.iter().all(|x| x.is_finite() && *x >= 0.0));
