@@ -177,7 +177,7 @@ pub fn run_in(
             save: &mut save,
         };
         let total = match block {
-            Block::Own => own_block(&mut state, shots, renderer, config, &space, &mut steps)?,
+            Block::Own => own_block(&mut state, shots, renderer, config, &space, dir, &mut steps)?,
             Block::Shared => shared_block(
                 &mut state, shots, renderer, config, &space, observer, dir, &mut steps,
             )?,
@@ -321,11 +321,21 @@ fn own_block(
     renderer: &dyn Renderer,
     config: &SetConfig,
     space: &ParamSpace,
+    dir: Option<&RunDir>,
     steps: &mut Steps,
 ) -> Result<f64> {
     let done = state.within.own_parts.len();
     for (i, shot) in shots.iter().enumerate().skip(done) {
-        let d = own_fit(state, i, shot, renderer, config, space)?;
+        let interrupted = || {
+            let flag = config.fit.interrupt.as_ref();
+            flag.is_some_and(|f| f.load(std::sync::atomic::Ordering::SeqCst))
+        };
+        // A photograph's fit runs in memory: its own "nothing was saved"
+        // is not the set's, whose state resumes the run.
+        let d = match own_fit(state, i, shot, renderer, config, space) {
+            Err(_) if interrupted() => return Err(halt_error(Halt::Interrupted, dir)),
+            r => r?,
+        };
         (steps.clear)()?;
         state.within.push_part(d);
         (steps.save)(state)?;
