@@ -528,3 +528,197 @@ fn a_finished_fit_keeps_its_population_for_the_report() {
     let pop = &c["search"]["de"]["population"];
     assert_eq!(pop.as_array().map(|p| p.len()), Some(10), "{c}");
 }
+
+/// A set of two photographs of the scene (target.png and a copy) in
+/// shots.json, for the set fit's run-directory cases.
+fn setup_set() -> tempfile::TempDir {
+    let d = setup();
+    std::fs::copy(d.path().join("target.png"), d.path().join("other.png")).unwrap();
+    let shots = r#"{"format": "scenefit-shots/1", "shots": [
+        {"name": "a", "target": "target.png"}, {"name": "b", "target": "other.png"}]}"#;
+    std::fs::write(d.path().join("shots.json"), shots).unwrap();
+    d
+}
+
+/// `fit --shots` into `out`, small.
+fn fit_set(d: &Path, shots: &str, out: &str, extra: &[&str]) -> std::process::Output {
+    let mut args = vec![
+        "fit",
+        "scene.json",
+        "--shots",
+        shots,
+        "-o",
+        out,
+        "--generations",
+        "4",
+        "--population",
+        "10",
+        "-q",
+    ];
+    args.extend_from_slice(extra);
+    scenefit(d, &args)
+}
+
+#[test]
+fn a_set_fit_refuses_an_earlier_set_run_and_resumes_a_finished_one() {
+    let d = setup_set();
+    assert!(fit_set(d.path(), "shots.json", "run", &[]).status.success());
+    let result = std::fs::read(d.path().join("run/result.json")).unwrap();
+    refused(
+        &fit_set(d.path(), "shots.json", "run", &[]),
+        &["checkpoint", "--resume", "--overwrite"],
+    );
+    let out = fit_set(d.path(), "shots.json", "run", &["--resume"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let again = std::fs::read(d.path().join("run/result.json")).unwrap();
+    let params =
+        |b: &[u8]| serde_json::from_slice::<serde_json::Value>(b).unwrap()["params"].clone();
+    assert_eq!(params(&again), params(&result));
+}
+
+#[test]
+fn a_set_photograph_the_run_would_overwrite_is_refused() {
+    let d = setup_set();
+    assert!(fit_set(d.path(), "shots.json", "run", &[]).status.success());
+    // The photograph of shot "a" stored in the run directory as the name
+    // of a shot's best render.
+    std::fs::copy(d.path().join("target.png"), d.path().join("run/best_a.png")).unwrap();
+    let kept = std::fs::read(d.path().join("run/best_a.png")).unwrap();
+    let shots = r#"{"format": "scenefit-shots/1", "shots": [
+        {"name": "a", "target": "run/best_a.png"}, {"name": "b", "target": "other.png"}]}"#;
+    std::fs::write(d.path().join("inside.json"), shots).unwrap();
+    refused(
+        &fit_set(d.path(), "inside.json", "run", &["--overwrite"]),
+        &["shot a", "best_a.png", "overwrite"],
+    );
+    assert_eq!(
+        std::fs::read(d.path().join("run/best_a.png")).unwrap(),
+        kept
+    );
+    // The shots file itself inside the run directory, under a run's name
+    // (its photographs named from there).
+    let shots = r#"{"format": "scenefit-shots/1", "shots": [
+        {"name": "a", "target": "../target.png"}, {"name": "b", "target": "../other.png"}]}"#;
+    std::fs::write(d.path().join("run/shots.json"), shots).unwrap();
+    refused(
+        &fit_set(d.path(), "run/shots.json", "run", &["--overwrite"]),
+        &["--shots", "shots.json"],
+    );
+}
+
+#[test]
+fn a_planted_lock_symlink_is_refused_and_not_followed() {
+    let d = setup();
+    std::fs::create_dir(d.path().join("run")).unwrap();
+    std::fs::write(d.path().join("victim.txt"), "precious").unwrap();
+    std::os::unix::fs::symlink(
+        d.path().join("victim.txt"),
+        d.path().join("run/.scenefit.lock"),
+    )
+    .unwrap();
+    refused(
+        &fit(d.path(), "run", &[]),
+        &[".scenefit.lock", "symbolic link"],
+    );
+    assert_eq!(
+        std::fs::read_to_string(d.path().join("victim.txt")).unwrap(),
+        "precious"
+    );
+}
+
+/// `diagnose run -o OUT`, small.
+fn diagnose(d: &Path, out: &str, extra: &[&str]) -> std::process::Output {
+    let mut args = vec![
+        "diagnose",
+        "run",
+        "-o",
+        out,
+        "--population",
+        "4",
+        "--generations",
+        "2",
+        "--restart-generations",
+        "0",
+        "--max-effects",
+        "1",
+    ];
+    args.extend_from_slice(extra);
+    scenefit(d, &args)
+}
+
+#[test]
+fn a_diagnosis_follows_the_run_directory_rule() {
+    let d = setup();
+    assert!(fit(d.path(), "run", &[]).status.success());
+    let out = diagnose(d.path(), "diag", &[]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let first = std::fs::read(d.path().join("diag/diagnosis.json")).unwrap();
+    // An earlier diagnosis is not silently replaced.
+    refused(&diagnose(d.path(), "diag", &[]), &["diag", "--overwrite"]);
+    assert_eq!(
+        std::fs::read(d.path().join("diag/diagnosis.json")).unwrap(),
+        first
+    );
+    refused(
+        &diagnose(d.path(), "diag", &["--resume"]),
+        &["--resume", "cannot be resumed"],
+    );
+    refused(&diagnose(d.path(), "run", &[]), &["fit directory"]);
+    // An input under a name the diagnosis writes is not overwritten.
+    std::fs::copy(
+        d.path().join("target.png"),
+        d.path().join("diag/render_after.png"),
+    )
+    .unwrap();
+    let kept = std::fs::read(d.path().join("diag/render_after.png")).unwrap();
+    refused(
+        &diagnose(
+            d.path(),
+            "diag",
+            &["--overwrite", "--target", "diag/render_after.png"],
+        ),
+        &["--target", "render_after.png"],
+    );
+    assert_eq!(
+        std::fs::read(d.path().join("diag/render_after.png")).unwrap(),
+        kept
+    );
+    std::fs::remove_file(d.path().join("diag/render_after.png")).unwrap();
+    std::fs::write(d.path().join("diag/notes.txt"), "mine").unwrap();
+    let out = diagnose(d.path(), "diag", &["--overwrite"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert_eq!(
+        std::fs::read_to_string(d.path().join("diag/notes.txt")).unwrap(),
+        "mine"
+    );
+}
+
+#[test]
+fn two_diagnoses_never_share_a_directory() {
+    let d = setup();
+    assert!(fit(d.path(), "run", &[]).status.success());
+    let bin = env!("CARGO_BIN_EXE_scenefit");
+    // A diagnosis long enough for the second to start while it runs.
+    let mut first = Command::new(bin)
+        .args(["diagnose", "run", "-o", "diag", "--max-effects", "1"])
+        .current_dir(d.path())
+        .stdout(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    let started = std::time::Instant::now();
+    while !d.path().join("diag/.scenefit.lock").exists() && started.elapsed().as_secs() < 30 {
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+    let second = diagnose(d.path(), "diag", &["--overwrite"]);
+    assert!(first.wait().unwrap().success());
+    refused(&second, &["in use"]);
+}
+
+#[test]
+fn report_on_a_set_fit_says_what_to_run() {
+    let d = setup_set();
+    assert!(fit_set(d.path(), "shots.json", "run", &[]).status.success());
+    let out = scenefit(d.path(), &["report", "run"]);
+    refused(&out, &["set of photographs", "scenefit diagnose"]);
+    assert!(!d.path().join("run/report.html").exists());
+}

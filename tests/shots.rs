@@ -176,7 +176,9 @@ fn the_joint_step_lowers_what_a_short_block_descent_leaves() {
     ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let state = read_json(&out.join("set_state.json"));
-    let history: Vec<f64> = serde_json::from_value(state["history"].clone()).unwrap();
+    // Stored bit-exact: each value's IEEE-754 bits.
+    let bits: Vec<u64> = serde_json::from_value(state["history"].clone()).unwrap();
+    let history: Vec<f64> = bits.into_iter().map(f64::from_bits).collect();
     eprintln!("set deviation after each block: {history:?}");
     let (before, after) = (history[history.len() - 2], history[history.len() - 1]);
     assert!(

@@ -1,11 +1,15 @@
 //! `scenefit diagnose FIT_DIR -o DIR`: find the effect a fit's model lacks,
-//! add it, refit, report before and after (src/diagnose/).
+//! add it, refit, report before and after (src/diagnose/). The output
+//! directory follows the run-directory rule (`rundir`): locked while the
+//! diagnosis runs, fresh unless `--overwrite`, no input inside it
+//! replaced; a diagnosis refits in memory and saves no state, so it
+//! cannot be resumed.
 
 use crate::diagnose::{self, DiagnoseConfig, Inputs};
 use crate::error::{Error, Result};
-use crate::rundir::SHOTS;
+use crate::rundir::{Kind, Mode, RunDir, SHOTS};
 use clap::Args;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 #[derive(Args, Debug)]
 pub struct DiagnoseArgs {
@@ -49,6 +53,20 @@ pub struct DiagnoseArgs {
     jobs: Option<usize>,
     #[command(flatten)]
     render_options: super::renderer_args::RendererArgs,
+    /// Replace an earlier diagnosis in the output directory (refused
+    /// without it).
+    #[arg(long)]
+    overwrite: bool,
+    /// Refused: a diagnosis refits in memory and saves no state to resume
+    /// from (run it again with --overwrite).
+    #[arg(long, conflicts_with = "overwrite")]
+    resume: bool,
+}
+
+/// What the fit directory holds: a set of photographs, or one.
+enum Fitted {
+    Set(diagnose::set::SetInputs),
+    One(Inputs),
 }
 
 pub fn run(a: DiagnoseArgs) -> Result<()> {
@@ -66,6 +84,22 @@ pub fn run(a: DiagnoseArgs) -> Result<()> {
             "--target/--mask: the fit directory holds a set of photographs; each one's target and mask come from its {SHOTS}"
         )));
     }
+    // The output is held and checked before the photograph is read: a
+    // refused diagnosis says only why.
+    let out = open_output(&a)?;
+    refuse_inputs(&out, &a, set.as_ref())?;
+    let fitted = match set {
+        Some(s) => Fitted::Set(s),
+        None => Fitted::One(Inputs::from_fit_dir(
+            &a.fit_dir,
+            a.target.as_deref(),
+            a.mask.as_deref(),
+        )?),
+    };
+    // An earlier diagnosis's files go only once this one has its inputs.
+    if a.overwrite {
+        out.clear()?;
+    }
     let mut config = DiagnoseConfig {
         renderer: a.renderer,
         render_options: a.render_options.options_in(&a.output)?,
@@ -81,12 +115,9 @@ pub fn run(a: DiagnoseArgs) -> Result<()> {
     if let Some(j) = a.jobs {
         config.jobs = j;
     }
-    let d = match set {
-        Some(set) => diagnose::set::run(&set, &a.output, &config)?.diagnosis,
-        None => {
-            let inputs = Inputs::from_fit_dir(&a.fit_dir, a.target.as_deref(), a.mask.as_deref())?;
-            diagnose::run(&inputs, &a.output, &config)?
-        }
+    let d = match fitted {
+        Fitted::Set(set) => diagnose::set::run(&set, &a.output, &config)?.diagnosis,
+        Fitted::One(inputs) => diagnose::run(&inputs, &a.output, &config)?,
     };
     println!(
         "deviation {:.3} % -> {:.3} %; accepted: {}; {} renders in {:.1} s; results in {}",
@@ -102,4 +133,50 @@ pub fn run(a: DiagnoseArgs) -> Result<()> {
         a.output.display()
     );
     Ok(())
+}
+
+/// The output directory, locked, by the run-directory rule; never the fit
+/// directory itself (the diagnosis's report.html would replace the fit's).
+fn open_output(a: &DiagnoseArgs) -> Result<RunDir> {
+    if a.resume {
+        return Err(Error::Usage(format!(
+            "--resume: a diagnosis cannot be resumed (its refits run in memory and save no state); run it again with --overwrite to replace {}",
+            a.output.display()
+        )));
+    }
+    let same = |p: &Path| p.canonicalize().ok();
+    if same(&a.output).is_some() && same(&a.output) == same(&a.fit_dir) {
+        return Err(Error::Usage(format!(
+            "-o {}: this is the fit directory; give the diagnosis a directory of its own",
+            a.output.display()
+        )));
+    }
+    let mode = if a.overwrite {
+        Mode::Overwrite
+    } else {
+        Mode::Fresh
+    };
+    RunDir::open_as(&a.output, mode, Kind::Named(crate::rundir::diagnosis_owns))
+}
+
+/// Refuses an input (the target, the mask, a shot's photograph or mask)
+/// that the diagnosis would overwrite in its output directory.
+fn refuse_inputs(
+    out: &RunDir,
+    a: &DiagnoseArgs,
+    set: Option<&diagnose::set::SetInputs>,
+) -> Result<()> {
+    let mut inputs: Vec<(String, &Path)> = [("--target", &a.target), ("--mask", &a.mask)]
+        .into_iter()
+        .filter_map(|(what, p)| p.as_deref().map(|p| (what.to_string(), p)))
+        .collect();
+    for s in set.iter().flat_map(|s| &s.shots) {
+        inputs.push((format!("shot {}'s target", s.name), &s.entry.target));
+        if let Some(m) = &s.entry.mask {
+            inputs.push((format!("shot {}'s mask", s.name), m));
+        }
+    }
+    inputs
+        .into_iter()
+        .try_for_each(|(what, p)| out.refuse_overwritten_input(p, &what))
 }

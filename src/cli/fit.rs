@@ -139,6 +139,9 @@ pub fn run(a: FitArgs) -> Result<()> {
     if let Some(m) = &a.inputs.mask {
         config.inputs.push(("--mask".into(), m.clone()));
     }
+    config
+        .inputs
+        .push(("the scene".into(), a.inputs.scene.clone()));
     config.interrupt = Some(interrupt_flag());
     let mut progress = Progress::new(a.quiet);
     let outcome = fit::run(
@@ -184,6 +187,12 @@ fn run_set(a: &FitArgs, scene: &Scene, shots: &[crate::fit::set::shots::Shot]) -
     crate::scene::memory::check_fit(avail, &file, (w, h), pop, config.jobs)?;
     config.mode = run_mode(a.resume, a.overwrite);
     config.interrupt = Some(interrupt_flag());
+    config
+        .inputs
+        .push(("the scene".into(), a.inputs.scene.clone()));
+    if let Some(s) = &a.inputs.shots {
+        config.inputs.push(("--shots".into(), s.clone()));
+    }
     let set = fit::set::SetConfig {
         spread: Vec::new(),
         fit: config,

@@ -30,7 +30,7 @@
 
 mod config;
 mod de;
-mod exact;
+pub(crate) mod exact;
 pub mod functions;
 mod hybrid;
 mod identifiability;

@@ -75,7 +75,6 @@ pub const STAGE2_DE: &str = "stage2_de";
 /// The lock a run holds on its directory.
 const LOCK: &str = ".scenefit.lock";
 
-/// best_gNNNN.bmp: the best image at a generation, as the paper saved them.
 /// The best render of one photograph of a set.
 pub fn shot_best_name(shot: &str) -> String {
     format!("best_{shot}.png")
@@ -93,9 +92,39 @@ pub fn shot_residual_after(shot: &str) -> String {
     format!("residual_after_{shot}.png")
 }
 
+/// True for a name a diagnosis writes: what `diagnose --overwrite`
+/// replaces, and what no input inside its output directory may be.
+pub fn diagnosis_owns(name: &str) -> bool {
+    let per_shot = |prefix: &str| {
+        name.strip_prefix(prefix)
+            .and_then(|n| n.strip_suffix(".png"))
+            .is_some_and(|shot| !shot.is_empty())
+    };
+    [
+        DIAGNOSIS_JSON,
+        IMPROVED_SCENE,
+        RESIDUAL_BEFORE,
+        RESIDUAL_AFTER,
+        RENDER_AFTER,
+        REPORT,
+    ]
+    .contains(&name)
+        || per_shot("render_after_")
+        || per_shot("residual_before_")
+        || per_shot("residual_after_")
+}
+
 /// The snapshots' names as a reader is told them.
 pub const SNAPSHOTS: &str = "best_gNNNN.bmp";
 
+/// True for a name `shot_best_name` gives (a set's render of a photograph).
+fn is_shot_best(name: &str) -> bool {
+    name.strip_prefix("best_")
+        .and_then(|n| n.strip_suffix(".png"))
+        .is_some_and(|shot| !shot.is_empty())
+}
+
+/// best_gNNNN.bmp: the best image at a generation, as the paper saved them.
 pub fn snapshot_name(generation: usize) -> String {
     format!("best_g{generation:04}.bmp")
 }
@@ -110,13 +139,19 @@ pub fn snapshot_generation(name: &str) -> Option<usize> {
 
 /// The kind of run a directory holds: it decides which names are the
 /// run's own (what `--overwrite` removes and what no input may be).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug)]
 pub enum Kind {
     /// A fit: its results, logs, snapshots and a report of it.
     Fit,
     /// A pipeline: its copies of the target and mask, its comparison and
     /// report, and its stage directories (each a fit).
     Pipeline,
+    /// A set fit (`fit --shots`): a fit's files, its state between
+    /// blocks, its shots file and every photograph's best render.
+    Set,
+    /// Another command's directory (a diagnosis): the names it writes,
+    /// as its own module lists them (rundir imports none of them).
+    Named(fn(&str) -> bool),
 }
 
 impl Kind {
@@ -138,12 +173,15 @@ impl Kind {
             Kind::Pipeline => {
                 fit || [TARGET, MASK, INPUT_SCENE, HANDOVER, COMPARISON].contains(&name)
             }
+            Kind::Set => fit || name == SET_STATE || name == SHOTS || is_shot_best(name),
+            Kind::Named(owns) => owns(name),
         }
     }
 
     fn owns_dir(self, name: &str) -> bool {
         name == FIGURES
-            || (self == Kind::Pipeline && (name == STAGE1 || name == STAGE2 || name == STAGE2_DE))
+            || (matches!(self, Kind::Pipeline)
+                && (name == STAGE1 || name == STAGE2 || name == STAGE2_DE))
     }
 }
 
@@ -192,18 +230,22 @@ impl RunDir {
         dir.remove_stale_temps();
         match mode {
             Mode::Fresh => dir.require_empty()?,
-            Mode::Resume => {
-                let stage1 = Path::new(STAGE1).join(CHECKPOINT);
-                if !dir.file(CHECKPOINT).is_file() && !dir.path.join(stage1).is_file() {
-                    return Err(Error::Usage(format!(
-                        "{}: nothing to resume (no {CHECKPOINT}); run without --resume to start afresh",
-                        path.display()
-                    )));
-                }
-            }
+            Mode::Resume => dir.require_state()?,
             Mode::Overwrite => {}
         }
         Ok(dir)
+    }
+
+    /// A finished run's directory that a command adds to (a report):
+    /// it must exist, and it is locked so that no run is writing it.
+    pub fn update(path: &Path, kind: Kind) -> Result<RunDir> {
+        if !path.is_dir() {
+            return Err(Error::Usage(format!(
+                "{}: not a directory of a scenefit run",
+                path.display()
+            )));
+        }
+        RunDir::open_as(path, Mode::Overwrite, kind)
     }
 
     /// A directory to read a finished run from, without a lock.
@@ -254,6 +296,25 @@ impl RunDir {
         }
     }
 
+    /// What `--resume` continues from: the state file of this kind of run.
+    fn require_state(&self) -> Result<()> {
+        let (states, stage1): (&[&str], bool) = match self.kind {
+            Kind::Fit => (&[CHECKPOINT], false),
+            Kind::Pipeline => (&[CHECKPOINT], true),
+            Kind::Set => (&[SET_STATE], false),
+            Kind::Named(_) => (&[], false),
+        };
+        let stage1 = stage1 && self.path.join(STAGE1).join(CHECKPOINT).is_file();
+        if stage1 || states.iter().any(|s| self.file(s).is_file()) {
+            return Ok(());
+        }
+        Err(Error::Usage(format!(
+            "{}: nothing to resume (no {}); run without --resume to start afresh",
+            self.path.display(),
+            states.first().copied().unwrap_or("saved state")
+        )))
+    }
+
     fn require_empty(&self) -> Result<()> {
         let entries = std::fs::read_dir(&self.path).map_err(|e| Error::io(&self.path, e))?;
         let mut names: Vec<String> = entries
@@ -265,13 +326,17 @@ impl RunDir {
             return Ok(());
         }
         names.sort();
-        let what = if names.iter().any(|n| n == CHECKPOINT) {
+        let what = if names.iter().any(|n| n == CHECKPOINT || n == SET_STATE) {
             "an earlier run's checkpoint"
         } else {
             "files"
         };
+        let resume = match self.kind {
+            Kind::Named(_) => "",
+            _ => "--resume to continue that run, ",
+        };
         Err(Error::Usage(format!(
-            "{}: the output directory already holds {what} ({}{}); pass --resume to continue that run, --overwrite to replace it, or choose another directory",
+            "{}: the output directory already holds {what} ({}{}); pass {resume}--overwrite to replace it, or choose another directory",
             self.path.display(),
             names.iter().take(3).cloned().collect::<Vec<_>>().join(", "),
             if names.len() > 3 { ", …" } else { "" }
@@ -380,6 +445,22 @@ impl RunDir {
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn a_diagnosis_owns_every_name_it_writes_and_nothing_else() {
+        for n in [
+            DIAGNOSIS_JSON.to_string(),
+            REPORT.into(),
+            shot_render_after("s1"),
+            shot_residual_before("s1"),
+            shot_residual_after("s1"),
+        ] {
+            assert!(diagnosis_owns(&n), "{n}");
+        }
+        for n in ["photo.png", "render_after_.png", "notes.txt", "result.json"] {
+            assert!(!diagnosis_owns(n), "{n}");
+        }
+    }
+
     use super::*;
 
     #[test]

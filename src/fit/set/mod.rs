@@ -18,8 +18,10 @@
 //! `--joint`, one joint block moves every coordinate at once by
 //! Levenberg–Marquardt (`joint`), which follows the valleys where shared
 //! and per-shot values trade.
-//! Later blocks start around the current values. The state is saved after every block
-//! (`state`), so `--resume` continues from the last finished block.
+//! Later blocks start around the current values. The state is saved after
+//! every photograph of a per-shot block and every generation of a shared
+//! block (`state`), so `--resume` continues where the run stopped, to the
+//! result an uninterrupted run gives.
 
 mod joint;
 mod outcome;
@@ -38,13 +40,14 @@ use super::executor::{Executor, Halt, Offsets};
 use super::{FitConfig, Observer};
 use crate::error::{Error, Result};
 use crate::fit::set::shots::Shot;
+use crate::metric::Deviation;
 use crate::optimize::{Search, Searcher, Start, StopRule};
 use crate::render::Renderer;
-use crate::rundir::{Mode, RunDir};
+use crate::rundir::{Kind, Mode, RunDir};
 use crate::scene::{ParamSpace, Scene};
 use problem::SetProblem;
 use setup::{block_seed, varying};
-use state::SetState;
+use state::{SetState, Within};
 use std::path::Path;
 use std::time::Instant;
 
@@ -99,12 +102,15 @@ pub fn run(
     dir: &Path,
     observer: &mut dyn Observer,
 ) -> Result<SetOutcome> {
-    let run_dir = RunDir::open(dir, config.fit.mode)?;
+    let run_dir = RunDir::open_as(dir, config.fit.mode, Kind::Set)?;
     for s in shots {
         run_dir.refuse_overwritten_input(&s.entry.target, &format!("shot {}'s target", s.name))?;
         if let Some(m) = &s.entry.mask {
             run_dir.refuse_overwritten_input(m, &format!("shot {}'s mask", s.name))?;
         }
+    }
+    for (what, p) in &config.fit.inputs {
+        run_dir.refuse_overwritten_input(p, what)?;
     }
     run_in(scene, shots, renderer, config, Some(&run_dir), observer)
 }
@@ -127,6 +133,15 @@ pub fn run_in(
     let started = Instant::now();
     let before = state.seconds;
     let mut cleared = config.fit.mode != Mode::Overwrite;
+    let mut save = |state: &mut SetState| -> Result<()> {
+        state.seconds = before + started.elapsed().as_secs_f64();
+        dir.map_or(Ok(()), |d| state.save(d))
+    };
+    // A fresh run is resumable from its start (an overwriting one once
+    // the earlier run's files are gone: its first save).
+    if config.fit.mode == Mode::Fresh {
+        save(&mut state)?;
+    }
     while state.blocks_done < plan.len() {
         let block = plan[state.blocks_done];
         let mut clear = || -> Result<()> {
@@ -138,25 +153,36 @@ pub fn run_in(
             }
             Ok(())
         };
-        let total = match block {
-            Block::Own => own_block(&mut state, shots, renderer, config, &space, &mut clear)?,
-            Block::Shared => shared_block(
-                &mut state, shots, renderer, config, &space, observer, dir, &mut clear,
-            )?,
-            Block::Joint => joint::run(&mut state, shots, renderer, config, &space, &mut clear)?,
+        let mut steps = Steps {
+            clear: &mut clear,
+            save: &mut save,
         };
+        let total = match block {
+            Block::Own => own_block(&mut state, shots, renderer, config, &space, dir, &mut steps)?,
+            Block::Shared => shared_block(
+                &mut state, shots, renderer, config, &space, observer, dir, &mut steps,
+            )?,
+            Block::Joint => joint::run(&mut state, shots, renderer, config, &space, steps.clear)?,
+        };
+        state.within = Within::default();
         state.history.push(total);
         state.blocks_done += 1;
         if block == Block::Own && converged(&state.history) {
             // Straight to the joint block, if there is one.
             state.blocks_done = plan.len() - usize::from(plan.last() == Some(&Block::Joint));
         }
-        state.seconds = before + started.elapsed().as_secs_f64();
-        if let Some(d) = dir {
-            state.save(d)?;
-        }
+        save(&mut state)?;
     }
     outcome::finish(&state, scene, shots, renderer, config, &space, dir)
+}
+
+/// What a block calls besides its search: `clear` once it is ready to
+/// write (an overwriting run removes the earlier run's files then), `save`
+/// after each step it has finished (the state written, when there is a
+/// run directory).
+struct Steps<'a> {
+    clear: &'a mut dyn FnMut() -> Result<()>,
+    save: &'a mut dyn FnMut(&mut SetState) -> Result<()>,
 }
 
 /// A step of the alternation.
@@ -223,7 +249,8 @@ fn check_inputs(scene: &Scene, shots: &[Shot], config: &SetConfig) -> Result<Par
     Ok(space)
 }
 
-/// Fits each photograph's own parameters with the shared ones held; the
+/// Fits each photograph's own parameters with the shared ones held,
+/// saving after each photograph (a resumed block skips those done); the
 /// set's deviation after it.
 fn own_block(
     state: &mut SetState,
@@ -231,39 +258,65 @@ fn own_block(
     renderer: &dyn Renderer,
     config: &SetConfig,
     space: &ParamSpace,
-    clear: &mut dyn FnMut() -> Result<()>,
+    dir: Option<&RunDir>,
+    steps: &mut Steps,
 ) -> Result<f64> {
-    let shared = space.shared();
-    let mut parts = Vec::with_capacity(shots.len());
-    for (i, shot) in shots.iter().enumerate() {
-        let own = shot.own_space(space);
-        let base = state.shot_scene(i, shot, &shared, &own);
-        if own.is_empty() {
-            let img = crate::render::render_one(renderer, &base, 0)?;
-            clear()?;
-            let t = &shot.target;
-            parts.push((
-                crate::metric::deviation(&t.image, &img, t.mask.as_ref()),
-                problem::counted(t),
-            ));
-            continue;
-        }
-        let mut fit_scene = base.clone();
-        fit_scene
-            .free
-            .retain(|f| own.specs.iter().any(|s| s.name == f.param));
-        let seed = block_seed(config.fit.de.seed, state.blocks_done, i);
-        let mut cfg = block_config(&config.fit, own.dim(), seed);
-        cfg.start_radius = (state.blocks_done > 0 || config.warm).then_some(LATER_RADIUS);
-        let out = super::run_in_memory(&fit_scene, &shot.target, renderer, &cfg, &mut ())?;
-        clear()?;
-        state.own[i] = own.unit_of(&out.scene);
-        state.evaluations += out.result.evaluations;
-        state.generations += out.result.generations;
-        state.failed_renders += out.result.failed_renders;
-        parts.push((out.result.deviation, problem::counted(&shot.target)));
+    let done = state.within.own_parts.len();
+    for (i, shot) in shots.iter().enumerate().skip(done) {
+        let interrupted = || {
+            let flag = config.fit.interrupt.as_ref();
+            flag.is_some_and(|f| f.load(std::sync::atomic::Ordering::SeqCst))
+        };
+        // A photograph's fit runs in memory: its own "nothing was saved"
+        // is not the set's, whose state resumes the run.
+        let d = match own_fit(state, i, shot, renderer, config, space) {
+            Err(_) if interrupted() => return Err(halt_error(Halt::Interrupted, dir)),
+            r => r?,
+        };
+        (steps.clear)()?;
+        state.within.push_part(d);
+        (steps.save)(state)?;
     }
-    Ok(crate::metric::Deviation::pooled(&parts).average)
+    let parts: Vec<(Deviation, usize)> = state
+        .within
+        .parts()
+        .into_iter()
+        .zip(shots)
+        .map(|(d, s)| (d, problem::counted(&s.target)))
+        .collect();
+    Ok(Deviation::pooled(&parts).average)
+}
+
+/// Photograph `i`'s own parameters fitted with the shared ones held, from
+/// the seed of this block and photograph; its deviation after.
+fn own_fit(
+    state: &mut SetState,
+    i: usize,
+    shot: &Shot,
+    renderer: &dyn Renderer,
+    config: &SetConfig,
+    space: &ParamSpace,
+) -> Result<Deviation> {
+    let own = shot.own_space(space);
+    let base = state.shot_scene(i, shot, &space.shared(), &own);
+    let t = &shot.target;
+    if own.is_empty() {
+        let img = crate::render::render_one(renderer, &base, 0)?;
+        return Ok(crate::metric::deviation(&t.image, &img, t.mask.as_ref()));
+    }
+    let mut fit_scene = base;
+    fit_scene
+        .free
+        .retain(|f| own.specs.iter().any(|s| s.name == f.param));
+    let seed = block_seed(config.fit.de.seed, state.blocks_done, i);
+    let mut cfg = block_config(&config.fit, own.dim(), seed);
+    cfg.start_radius = (state.blocks_done > 0 || config.warm).then_some(LATER_RADIUS);
+    let out = super::run_in_memory(&fit_scene, t, renderer, &cfg, &mut ())?;
+    state.own[i] = own.unit_of(&out.scene);
+    state.evaluations += out.result.evaluations;
+    state.generations += out.result.generations;
+    state.failed_renders += out.result.failed_renders;
+    Ok(out.result.deviation)
 }
 
 /// Fits the shared parameters over every photograph at once, each with its
@@ -277,7 +330,7 @@ fn shared_block(
     space: &ParamSpace,
     observer: &mut dyn Observer,
     dir: Option<&RunDir>,
-    clear: &mut dyn FnMut() -> Result<()>,
+    steps: &mut Steps,
 ) -> Result<f64> {
     let shared = space.shared();
     let bases: Vec<Scene> = shots
@@ -289,7 +342,7 @@ fn shared_block(
         })
         .collect();
     let mut session = renderer.session(&bases[0], &varying(space, shots), config.fit.jobs)?;
-    clear()?;
+    (steps.clear)()?;
     let targets = shots.iter().map(|s| &s.target).collect();
     let seed = block_seed(config.fit.de.seed, state.blocks_done, 0);
     let mut problem = SetProblem::new(session.as_mut(), shared.clone(), bases, targets, seed);
@@ -301,8 +354,12 @@ fn shared_block(
         center: &state.shared,
         radii: &radii,
     };
-    let mut search = Searcher::new(shared.dim(), &cfg.de, start);
-    search.set_periods(crate::fit::periods(&shared));
+    // A resumed block continues from its saved search.
+    let mut search = state.within.search.take().unwrap_or_else(|| {
+        let mut s = Searcher::new(shared.dim(), &cfg.de, start);
+        s.set_periods(crate::fit::periods(&shared));
+        s
+    });
     let mut executor = Executor {
         rule: StopRule {
             max_generations: cfg.generations,
@@ -319,7 +376,11 @@ fn shared_block(
         total_generations: state.generations + config.fit.generations,
         phase: 1,
     };
-    let halted = executor.run(&mut problem, &mut search, offsets, &mut |_, _| Ok(()));
+    let mut save = |s: &Searcher, _: f64| -> Result<()> {
+        state.within.search = Some(s.clone());
+        (steps.save)(state)
+    };
+    let halted = executor.run(&mut problem, &mut search, offsets, &mut save);
     if let Err(h) = halted {
         return Err(halt_error(h, dir));
     }
@@ -336,7 +397,7 @@ fn shared_block(
 fn halt_error(h: Halt, dir: Option<&RunDir>) -> Error {
     let place = match dir {
         Some(d) => format!(
-            "{} resumes the run from its last finished block (--resume)",
+            "{} resumes the run where it stopped (--resume)",
             d.path().display()
         ),
         None => "nothing was saved".into(),

@@ -1,18 +1,26 @@
-//! A set fit's state between blocks, saved after every block
-//! (`set_state.json`) so that `--resume` continues from the last finished
-//! one; it records what defines the run (one identity per photograph) and
-//! refuses a resume with other inputs.
+//! A set fit's state, saved (`set_state.json`) when the run starts, after
+//! every photograph of a per-shot block and every generation of a shared
+//! block, so that `--resume` continues where the run stopped and ends
+//! where an uninterrupted run ends: a photograph's fit cut short is redone
+//! from its own seed, a shared block continues from its saved search.
+//! Every `f64` a later block reads is stored bit-exactly
+//! (`optimize::exact`): a value off by one ulp would send the resumed run
+//! elsewhere. It records what defines the run (one identity per
+//! photograph) and refuses a resume with other inputs.
 
 use super::SetConfig;
 use crate::error::{Error, Result};
 use crate::fit::identity::RunIdentity;
 use crate::fit::set::shots::Shot;
+use crate::metric::Deviation;
+use crate::optimize::{exact, Searcher};
 use crate::render::Renderer;
 use crate::rundir::{RunDir, SET_STATE};
 use crate::scene::{ParamSpace, Scene};
 use serde::{Deserialize, Serialize};
 
-const FORMAT: &str = "scenefit-set-state/1";
+/// Format 2: values bit-exact, and the progress within a block.
+const FORMAT: &str = "scenefit-set-state/2";
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct SetState {
@@ -21,18 +29,53 @@ pub struct SetState {
     pub identities: Vec<RunIdentity>,
     pub rounds: usize,
     /// The shared parameters, unit cube.
+    #[serde(with = "exact::vector")]
     pub shared: Vec<f64>,
     /// Each photograph's own parameters, unit cube.
+    #[serde(with = "exact::matrix")]
     pub own: Vec<Vec<f64>>,
     pub blocks_done: usize,
     pub shared_blocks: usize,
     /// The set's average deviation after each block.
+    #[serde(with = "exact::vector")]
     pub history: Vec<f64>,
     /// Renders so far.
     pub evaluations: usize,
     pub generations: usize,
     pub failed_renders: usize,
     pub seconds: f64,
+    /// What of the block in progress is done.
+    pub within: Within,
+}
+
+/// The progress within the block in progress (empty between blocks).
+#[derive(Clone, Debug, Default, Serialize, Deserialize)]
+pub struct Within {
+    /// A per-shot block: the deviation (r, g, b, average) of each
+    /// photograph fitted so far, in order.
+    #[serde(with = "exact::matrix")]
+    pub own_parts: Vec<Vec<f64>>,
+    /// A shared block: its search after its last generation.
+    pub search: Option<Searcher>,
+}
+
+impl Within {
+    pub fn push_part(&mut self, d: Deviation) {
+        self.own_parts.push(vec![d.r, d.g, d.b, d.average]);
+    }
+
+    /// The deviations of the photographs fitted so far.
+    pub fn parts(&self) -> Vec<Deviation> {
+        self.own_parts
+            .iter()
+            .map(|p| Deviation {
+                r: p[0],
+                g: p[1],
+                b: p[2],
+                average: p[3],
+            })
+            .collect()
+    }
 }
 
 impl SetState {
@@ -61,6 +104,7 @@ impl SetState {
             generations: 0,
             failed_renders: 0,
             seconds: 0.0,
+            within: Within::default(),
         }
     }
 
@@ -123,6 +167,7 @@ impl SetState {
         if !(s.seconds.is_finite() && s.seconds >= 0.0) {
             return Err(bad("seconds", "expected seconds >= 0"));
         }
+        check_within(&s, shots.len(), fresh.shared.len()).map_err(|(k, w)| bad(k, w))?;
         Ok(s)
     }
 
@@ -141,6 +186,47 @@ impl SetState {
         let s = shared.scene_at(&shot.scene, &self.shared);
         own.scene_at(&s, &self.own[i])
     }
+}
+
+/// The progress within a block, checked against the set: no more parts
+/// than photographs, each four finite numbers; a search over the shared
+/// coordinates.
+fn check_within(
+    s: &SetState,
+    shots: usize,
+    shared: usize,
+) -> std::result::Result<(), (&'static str, &'static str)> {
+    let w = &s.within;
+    let parts_ok = w.own_parts.len() <= shots
+        && w.own_parts
+            .iter()
+            .all(|p| p.len() == 4 && p.iter().all(|x| x.is_finite() && *x >= 0.0));
+    if !parts_ok {
+        return Err((
+            "within.own_parts",
+            "expected four deviations >= 0 for each photograph fitted so far",
+        ));
+    }
+    let search_ok = w.search.as_ref().is_none_or(|q| {
+        use crate::optimize::Search;
+        q.best().0.len() == shared
+            && q.population().is_none_or(|(p, f)| {
+                p.len() == f.len()
+                    && p.iter()
+                        .all(|u| u.len() == shared && u.iter().all(|x| x.is_finite()))
+            })
+    });
+    if !search_ok || (w.search.is_some() && !w.own_parts.is_empty()) {
+        return Err((
+            "within.search",
+            "expected a search over the scene's shared coordinates",
+        ));
+    }
+    let unit_ok = s.history.iter().all(|h| h.is_finite() && *h >= 0.0);
+    if !unit_ok {
+        return Err(("history", "expected deviations >= 0"));
+    }
+    Ok(())
 }
 
 fn identities(shots: &[Shot], renderer: &dyn Renderer, config: &SetConfig) -> Vec<RunIdentity> {
