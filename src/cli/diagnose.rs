@@ -1,10 +1,12 @@
 //! `scenefit diagnose FIT_DIR -o DIR`: find the effect a fit's model lacks,
 //! add it, refit, report before and after (src/diagnose/).
 
+use crate::diagnose::set::SetInputs;
 use crate::diagnose::{self, DiagnoseConfig, Inputs};
 use crate::error::{Error, Result};
+use crate::scene::memory::Population;
 use clap::Args;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 #[derive(Args, Debug)]
 pub struct DiagnoseArgs {
@@ -23,20 +25,20 @@ pub struct DiagnoseArgs {
     #[arg(long, default_value = "phong")]
     renderer: String,
     /// DE population of each refit.
-    #[arg(long, default_value_t = 16)]
+    #[arg(long, default_value_t = 16, value_parser = super::positive_count, allow_hyphen_values = true)]
     population: usize,
     /// Generations of each refit (searching the effect, then refining all).
-    #[arg(long, default_value_t = 80)]
+    #[arg(long, default_value_t = 80, value_parser = super::positive_count, allow_hyphen_values = true)]
     generations: usize,
     /// Generations of each refit from scratch (population 40; 0: none, about
     /// six times fewer renders, but effects that other parameters can fake
     /// are then missed).
-    #[arg(long, default_value_t = 250)]
+    #[arg(long, default_value_t = 250, value_parser = super::numbers::whole, allow_hyphen_values = true)]
     restart_generations: usize,
     /// Effects accepted at most.
-    #[arg(long, default_value_t = 3)]
+    #[arg(long, default_value_t = 3, value_parser = super::numbers::whole, allow_hyphen_values = true)]
     max_effects: usize,
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 1, value_parser = super::numbers::seed, allow_hyphen_values = true)]
     seed: u64,
     /// Refit the shared free parameters that move geometry (object shapes,
     /// the camera's placement) as well; by default they are held where the
@@ -44,7 +46,7 @@ pub struct DiagnoseArgs {
     #[arg(long)]
     refit_geometry: bool,
     /// Renders at once (default: the number of cores).
-    #[arg(long)]
+    #[arg(long, value_parser = super::positive_count, allow_hyphen_values = true)]
     jobs: Option<usize>,
     #[command(flatten)]
     render_options: super::renderer_args::RendererArgs,
@@ -80,6 +82,7 @@ pub fn run(a: DiagnoseArgs) -> Result<()> {
     if let Some(j) = a.jobs {
         config.jobs = j;
     }
+    check_memory(&a.fit_dir, &config, set.as_ref())?;
     let d = match set {
         Some(set) => diagnose::set::run(&set, &a.output, &config)?.diagnosis,
         None => {
@@ -101,4 +104,27 @@ pub fn run(a: DiagnoseArgs) -> Result<()> {
         a.output.display()
     );
     Ok(())
+}
+
+/// Refuses a diagnosis that would not fit in memory. Its refits run side
+/// by side, up to one per job, each with the largest of its populations
+/// and each candidate drawn once per photograph: counted as that many
+/// images of each candidate at once.
+/// Checked before a single fit's target is read, from its fitted scene.
+fn check_memory(fit_dir: &Path, c: &DiagnoseConfig, set: Option<&SetInputs>) -> Result<()> {
+    let file = fit_dir.join(crate::rundir::FITTED_SCENE);
+    let (scene, shots) = match set {
+        Some(s) => (s.scene.clone(), s.shots.len()),
+        None => (crate::scene::load(&file)?, 1),
+    };
+    let pop = Population {
+        option: "--population",
+        size: c
+            .population
+            .max(c.search_population)
+            .max(c.restart_population),
+        copies: c.jobs.saturating_mul(shots),
+    };
+    let size = (scene.image.width, scene.image.height);
+    crate::scene::memory::check(&file.display().to_string(), size, pop, c.jobs)
 }
