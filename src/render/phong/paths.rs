@@ -138,6 +138,10 @@ impl Paths {
                 budget: 0,
             };
             for y in rows {
+                // cut short on Ctrl-C: every render then fails (mod.rs)
+                if crate::exec::cancel::is_cancelled() {
+                    break;
+                }
                 for x in Geometry::row_span(&rects, y as f64, (y + 1) as f64, w) {
                     for sy in 0..aa {
                         for sx in 0..aa {
