@@ -107,9 +107,10 @@ pub fn run(a: DiagnoseArgs) -> Result<()> {
 }
 
 /// Refuses a diagnosis that would not fit in memory. Its refits run side
-/// by side, up to one per job, each with the largest of its populations
-/// and each candidate drawn once per photograph: counted as that many
-/// images of each candidate at once.
+/// by side, up to one per job and no more than a round's refits (each
+/// effect and the unchanged model, warm and from scratch), each with the
+/// largest of its populations and each candidate drawn once per
+/// photograph: counted as that many images of each candidate at once.
 /// Checked before a single fit's target is read, from its fitted scene.
 fn check_memory(fit_dir: &Path, c: &DiagnoseConfig, set: Option<&SetInputs>) -> Result<()> {
     let file = fit_dir.join(crate::rundir::FITTED_SCENE);
@@ -117,13 +118,14 @@ fn check_memory(fit_dir: &Path, c: &DiagnoseConfig, set: Option<&SetInputs>) -> 
         Some(s) => (s.scene.clone(), s.shots.len()),
         None => (crate::scene::load(&file)?, 1),
     };
+    let lanes = c.jobs.min(2 * (crate::diagnose::effects::ALL.len() + 1));
     let pop = Population {
         option: "--population",
         size: c
             .population
             .max(c.search_population)
             .max(c.restart_population),
-        copies: c.jobs.saturating_mul(shots),
+        copies: lanes.saturating_mul(shots),
     };
     let size = (scene.image.width, scene.image.height);
     crate::scene::memory::check(&file.display().to_string(), size, pop, c.jobs)
