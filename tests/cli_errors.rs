@@ -301,3 +301,289 @@ fn non_positive_exposure_and_white_balance() {
         &["w.json", "camera.white_balance", "positive"],
     );
 }
+
+/// Every numeric option of every command, given a negative number, says
+/// which option and what it expects (clap used to say only "unexpected
+/// argument '-1'").
+#[test]
+fn negative_numbers_name_their_option() {
+    let d = tempfile::tempdir().unwrap();
+    let scene = scenes().join("sphere_floor.json");
+    let scene = scene.to_str().unwrap();
+    let fit = ["fit", scene, "--target", "t.png", "-o", "out"];
+    let cases: Vec<(Vec<&str>, &str)> = [
+        (vec!["render", scene, "-o", "x.png"], "--seed"),
+        (vec!["render", scene, "-o", "x.png"], "--width"),
+        (fit.to_vec(), "--rounds"),
+        (fit.to_vec(), "--render-timeout"),
+        (fit.to_vec(), "--worker-max-renders"),
+        (fit.to_vec(), "--workers"),
+        (fit.to_vec(), "--population"),
+        (fit.to_vec(), "--generations"),
+        (fit.to_vec(), "--jobs"),
+        (fit.to_vec(), "--stagnation"),
+        (fit.to_vec(), "--seed"),
+        (fit.to_vec(), "--phase-generations"),
+        (vec!["diagnose", "fitdir", "-o", "out"], "--population"),
+        (vec!["diagnose", "fitdir", "-o", "out"], "--generations"),
+        (
+            vec!["diagnose", "fitdir", "-o", "out"],
+            "--restart-generations",
+        ),
+        (vec!["diagnose", "fitdir", "-o", "out"], "--max-effects"),
+        (vec!["diagnose", "fitdir", "-o", "out"], "--seed"),
+        (vec!["diagnose", "fitdir", "-o", "out"], "--jobs"),
+        (vec!["demo", "-o", "out"], "--population"),
+        (vec!["demo", "-o", "out"], "--seed"),
+        (
+            vec!["pipeline", scene, "--target", "t.png", "-o", "out"],
+            "--stage2-fine-renders",
+        ),
+        (
+            vec!["pipeline", scene, "--target", "t.png", "-o", "out"],
+            "--stage1-population",
+        ),
+    ]
+    .into_iter()
+    .collect();
+    for (mut args, flag) in cases {
+        args.extend([flag, "-1"]);
+        let out = scenefit(d.path(), &args);
+        assert_user_error(&out, &[&format!("'-1' for '{flag}"), "expected"]);
+    }
+    assert!(!d.path().join("out").exists() && !d.path().join("x.png").exists());
+}
+
+#[test]
+fn a_huge_worker_count_is_refused_by_its_option() {
+    let d = tempfile::tempdir().unwrap();
+    let scene = scenes().join("sphere_floor.json");
+    let out = scenefit(
+        d.path(),
+        &[
+            "fit",
+            scene.to_str().unwrap(),
+            "--target",
+            "t.png",
+            "-o",
+            "out",
+        ]
+        .into_iter()
+        .chain(["--renderer", "worker:true", "--workers", "1000000000"])
+        .collect::<Vec<_>>(),
+    );
+    assert_user_error(&out, &["--workers", "65536"]);
+}
+
+/// A fit directory with the example scene as its fitted scene, and the
+/// scene's rendered image as `t.png`.
+fn fit_dir_and_target(d: &Path) {
+    let scene = scenes().join("sphere_floor.json");
+    std::fs::create_dir(d.join("fitdir")).unwrap();
+    std::fs::copy(&scene, d.join("fitdir/fitted_scene.json")).unwrap();
+    let out = scenefit(d, &["render", scene.to_str().unwrap(), "-o", "t.png"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+}
+
+/// The memory estimate is checked by every command that renders, before
+/// it allocates, and the message names what to lower.
+#[test]
+fn every_command_checks_memory_first_naming_the_cause() {
+    let d = tempfile::tempdir().unwrap();
+    fit_dir_and_target(d.path());
+    let scene = scenes().join("sphere_floor.json");
+    let scene = scene.to_str().unwrap();
+    let huge = "100000000000";
+    let fit = ["fit", scene, "--target", "t.png", "-o", "out"];
+    let cases: [(Vec<&str>, Vec<&str>); 5] = [
+        (
+            [&fit[..], &["--jobs", huge]].concat(),
+            vec!["--jobs", "GiB"],
+        ),
+        (
+            [&fit[..], &["--population", huge]].concat(),
+            vec!["--population", "GiB"],
+        ),
+        (
+            vec!["demo", "-o", "out", "--population", huge],
+            vec!["--population", "GiB"],
+        ),
+        (
+            vec!["diagnose", "fitdir", "-o", "out", "--population", huge],
+            vec!["--population", "GiB"],
+        ),
+        (
+            vec!["diagnose", "fitdir", "-o", "out", "--jobs", huge],
+            vec!["--jobs", "GiB"],
+        ),
+    ];
+    for (args, needles) in cases {
+        let out = scenefit(d.path(), &args);
+        assert_user_error(&out, &needles);
+        assert!(!needles[0].is_empty() && !stderr(&out).contains("image.width"));
+    }
+    assert!(!d.path().join("out").exists());
+}
+
+/// `render` at the largest image size needs about 55 GiB: refused, naming
+/// the scene key, where the machine has less (else it is a valid render).
+#[test]
+fn a_render_too_large_for_memory_names_the_image_size() {
+    let meminfo = std::fs::read_to_string("/proc/meminfo").unwrap_or_default();
+    let avail_kib: f64 = meminfo
+        .lines()
+        .find(|l| l.starts_with("MemAvailable:"))
+        .and_then(|l| l.split_whitespace().nth(1)?.parse().ok())
+        .unwrap_or(f64::INFINITY);
+    if avail_kib > 50.0 * 1024.0 * 1024.0 {
+        eprintln!("skipped: this machine could render 16384x16384");
+        return;
+    }
+    let d = tempfile::tempdir().unwrap();
+    let scene = scenes().join("sphere_floor.json");
+    let out = scenefit(
+        d.path(),
+        &[
+            "render",
+            scene.to_str().unwrap(),
+            "-o",
+            "x.png",
+            "--width",
+            "16384",
+            "--height",
+            "16384",
+        ],
+    );
+    assert_user_error(
+        &out,
+        &["sphere_floor.json", "image.width", "16384x16384", "GiB"],
+    );
+    assert!(!d.path().join("x.png").exists());
+}
+
+/// A checkpoint whose scene declares another (huge) image is refused on
+/// resume before anything of that size is allocated.
+#[test]
+fn a_resumed_checkpoint_declaring_a_huge_image_is_refused() {
+    let d = tempfile::tempdir().unwrap();
+    fit_dir_and_target(d.path());
+    let scene = scenes().join("sphere_floor.json");
+    let fit = |extra: &[&str]| {
+        let mut args = vec![
+            "fit",
+            scene.to_str().unwrap(),
+            "--target",
+            "t.png",
+            "-o",
+            "run",
+            "-q",
+            "--population",
+            "8",
+        ];
+        args.extend(extra);
+        scenefit(d.path(), &args)
+    };
+    let out = fit(&["--generations", "2"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let path = d.path().join("run/checkpoint.json");
+    let mut c = json(&path);
+    c["base"]["image"] = serde_json::json!({"width": 16384, "height": 16384});
+    std::fs::write(&path, c.to_string()).unwrap();
+    let out = fit(&["--resume", "--generations", "4"]);
+    assert_user_error(&out, &["checkpoint.json", "base.image", "16384x16384"]);
+}
+
+/// A shots file that is an array, and a bad value in a shot's `set`: the
+/// message names the file, the shot and the key.
+#[test]
+fn shots_file_errors_name_the_shot_and_key() {
+    let d = tempfile::tempdir().unwrap();
+    let ball = scenes().join("diligent_ball");
+    let scene = ball.join("scene.json");
+    let shots = ball.join("shots24.json");
+    let mut v = json(&shots);
+    for s in v["shots"].as_array_mut().unwrap() {
+        for k in ["target", "mask"] {
+            let p = ball.join(s[k].as_str().unwrap());
+            s[k] = serde_json::json!(p.to_str().unwrap());
+        }
+    }
+    v["shots"][3]["set"] = serde_json::json!({"lights.led.intensity": "bright"});
+    write(d.path(), "bad.json", &v.to_string());
+    write(d.path(), "array.json", "[1, 2]");
+    let fit = |f: &str| {
+        let args = ["fit", scene.to_str().unwrap(), "--shots", f, "-o", "out"];
+        scenefit(d.path(), &args)
+    };
+    assert_user_error(
+        &fit("bad.json"),
+        &["bad.json", "shots[3].set.lights.led.intensity", "string"],
+    );
+    assert_user_error(
+        &fit("array.json"),
+        &["array.json", "(top level)", "expected a JSON object"],
+    );
+}
+
+/// A line of a run directory's slurm-jobs.txt that is not a whole session
+/// prefix (`scenefit-` alone matched every scenefit task of the user) is
+/// ignored with a warning; a dead session's prefix is still cancelled.
+#[test]
+fn a_slurm_ledger_line_cancels_only_its_own_session() {
+    use std::os::unix::fs::PermissionsExt;
+    let d = tempfile::tempdir().unwrap();
+    fit_dir_and_target(d.path());
+    let bin = d.path().join("bin");
+    std::fs::create_dir(&bin).unwrap();
+    let log = d.path().join("scancel.log");
+    let scripts = [
+        (
+            "squeue",
+            "#!/bin/sh\ncase \"$*\" in *--steps*) exit 0;; esac\necho '101 scenefit-999999999-1-0-1'\necho '202 scenefit-777-5-0-1'\n".to_string(),
+        ),
+        ("scancel", format!("#!/bin/sh\necho \"$*\" >> {}\n", log.display())),
+    ];
+    for (name, text) in scripts {
+        let p = bin.join(name);
+        std::fs::write(&p, text).unwrap();
+        std::fs::set_permissions(&p, std::fs::Permissions::from_mode(0o755)).unwrap();
+    }
+    std::fs::create_dir(d.path().join("run")).unwrap();
+    write(
+        &d.path().join("run"),
+        "slurm-jobs.txt",
+        "scenefit-\nscenefit-999999999-1-0-\n",
+    );
+    let scene = scenes().join("sphere_floor.json");
+    let path = format!(
+        "{}:{}",
+        bin.display(),
+        std::env::var("PATH").unwrap_or_default()
+    );
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_scenefit"))
+        .args([
+            "fit",
+            scene.to_str().unwrap(),
+            "--target",
+            "t.png",
+            "-o",
+            "run",
+        ])
+        .args([
+            "--overwrite",
+            "-q",
+            "--population",
+            "4",
+            "--generations",
+            "1",
+        ])
+        .current_dir(d.path())
+        .env("PATH", path)
+        .output()
+        .unwrap();
+    let err = stderr(&out);
+    assert!(err.contains("slurm-jobs.txt: line 1: ignored"), "{err}");
+    let cancelled = std::fs::read_to_string(&log).unwrap_or_default();
+    assert!(cancelled.contains("101"), "{cancelled} / {err}");
+    assert!(!cancelled.contains("202"), "{cancelled}");
+}

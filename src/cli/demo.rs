@@ -12,12 +12,16 @@ use crate::error::{Error, Result};
 use crate::fit::{self, FitTarget};
 use crate::render::{from_spec, render_one};
 use crate::rundir::{Mode, RunDir, TARGET};
+use crate::scene::memory::Population;
 use crate::scene::{parse, ParamSpace, Scene, Value};
 use clap::Args;
 use std::path::PathBuf;
 
 /// The built-in scene: the paper's acquisition box.
 pub const PAPER_BOX: &str = include_str!("../../scenes/paper_box.json");
+
+/// How the built-in scene is named in messages.
+const BUILT_IN: &str = "scenes/paper_box.json (built in)";
 
 /// The paper's six sphere colours (Table II), as linear RGB.
 pub const COLOURS: [(&str, [f64; 3]); 6] = [
@@ -65,7 +69,7 @@ struct Row {
 }
 
 pub fn run(a: DemoArgs) -> Result<()> {
-    let base = parse(PAPER_BOX, "scenes/paper_box.json (built in)", &[])?;
+    let base = parse(PAPER_BOX, BUILT_IN, &[])?;
     let space = ParamSpace::from_scene(&base);
     let selected: Vec<(&str, [f64; 3])> = match &a.colours {
         None => COLOURS.to_vec(),
@@ -80,6 +84,13 @@ pub fn run(a: DemoArgs) -> Result<()> {
     };
     let renderer = from_spec("phong")?;
     let mut config = a.search.config(renderer.default_jobs())?;
+    let pop = Population {
+        option: "--population",
+        size: config.de.population,
+        copies: 1,
+    };
+    let size = (base.image.width, base.image.height);
+    crate::scene::memory::check(BUILT_IN, size, pop, config.jobs)?;
     config.interrupt = Some(interrupt_flag());
     let mut rows = Vec::new();
     for (name, rgb) in selected {

@@ -5,9 +5,11 @@
 //! replaced; a diagnosis refits in memory and saves no state, so it
 //! cannot be resumed.
 
+use crate::diagnose::set::SetInputs;
 use crate::diagnose::{self, DiagnoseConfig, Inputs};
 use crate::error::{Error, Result};
 use crate::rundir::{Kind, Mode, RunDir, SHOTS};
+use crate::scene::memory::Population;
 use clap::Args;
 use std::path::{Path, PathBuf};
 
@@ -28,20 +30,20 @@ pub struct DiagnoseArgs {
     #[arg(long, default_value = "phong")]
     renderer: String,
     /// DE population of each refit.
-    #[arg(long, default_value_t = 16)]
+    #[arg(long, default_value_t = 16, value_parser = super::numbers::positive_count, allow_hyphen_values = true)]
     population: usize,
     /// Generations of each refit (searching the effect, then refining all).
-    #[arg(long, default_value_t = 80)]
+    #[arg(long, default_value_t = 80, value_parser = super::numbers::positive_count, allow_hyphen_values = true)]
     generations: usize,
     /// Generations of each refit from scratch (population 40; 0: none, about
     /// six times fewer renders, but effects that other parameters can fake
     /// are then missed).
-    #[arg(long, default_value_t = 250)]
+    #[arg(long, default_value_t = 250, value_parser = super::numbers::whole, allow_hyphen_values = true)]
     restart_generations: usize,
     /// Effects accepted at most.
-    #[arg(long, default_value_t = 3)]
+    #[arg(long, default_value_t = 3, value_parser = super::numbers::whole, allow_hyphen_values = true)]
     max_effects: usize,
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 1, value_parser = super::numbers::seed, allow_hyphen_values = true)]
     seed: u64,
     /// Refit the shared free parameters that move geometry (object shapes,
     /// the camera's placement) as well; by default they are held where the
@@ -49,7 +51,7 @@ pub struct DiagnoseArgs {
     #[arg(long)]
     refit_geometry: bool,
     /// Renders at once (default: the number of cores).
-    #[arg(long)]
+    #[arg(long, value_parser = super::numbers::positive_count, allow_hyphen_values = true)]
     jobs: Option<usize>,
     #[command(flatten)]
     render_options: super::renderer_args::RendererArgs,
@@ -84,6 +86,22 @@ pub fn run(a: DiagnoseArgs) -> Result<()> {
             "--target/--mask: the fit directory holds a set of photographs; each one's target and mask come from its {SHOTS}"
         )));
     }
+    let mut config = DiagnoseConfig {
+        renderer: a.renderer.clone(),
+        render_options: a.render_options.options_in(&a.output)?,
+        population: a.population,
+        search_generations: a.generations / 2,
+        refine_generations: a.generations - a.generations / 2,
+        max_rounds: a.max_effects,
+        restart_generations: a.restart_generations,
+        seed: a.seed,
+        refit_geometry: a.refit_geometry,
+        ..DiagnoseConfig::default()
+    };
+    if let Some(j) = a.jobs {
+        config.jobs = j;
+    }
+    check_memory(&a.fit_dir, &config, set.as_ref())?;
     // The output is held and checked before the photograph is read: a
     // refused diagnosis says only why.
     let out = open_output(&a)?;
@@ -99,21 +117,6 @@ pub fn run(a: DiagnoseArgs) -> Result<()> {
     // An earlier diagnosis's files go only once this one has its inputs.
     if a.overwrite {
         out.clear()?;
-    }
-    let mut config = DiagnoseConfig {
-        renderer: a.renderer,
-        render_options: a.render_options.options_in(&a.output)?,
-        population: a.population,
-        search_generations: a.generations / 2,
-        refine_generations: a.generations - a.generations / 2,
-        max_rounds: a.max_effects,
-        restart_generations: a.restart_generations,
-        seed: a.seed,
-        refit_geometry: a.refit_geometry,
-        ..DiagnoseConfig::default()
-    };
-    if let Some(j) = a.jobs {
-        config.jobs = j;
     }
     let d = match fitted {
         Fitted::Set(set) => diagnose::set::run(&set, &a.output, &config)?.diagnosis,
@@ -179,4 +182,29 @@ fn refuse_inputs(
     inputs
         .into_iter()
         .try_for_each(|(what, p)| out.refuse_overwritten_input(p, &what))
+}
+
+/// Refuses a diagnosis that would not fit in memory. Its refits run side
+/// by side, up to one per job and no more than a round's refits (each
+/// effect and the unchanged model, warm and from scratch), each with the
+/// largest of its populations and each candidate drawn once per
+/// photograph: counted as that many images of each candidate at once.
+/// Checked before a single fit's target is read, from its fitted scene.
+fn check_memory(fit_dir: &Path, c: &DiagnoseConfig, set: Option<&SetInputs>) -> Result<()> {
+    let file = fit_dir.join(crate::rundir::FITTED_SCENE);
+    let (scene, shots) = match set {
+        Some(s) => (s.scene.clone(), s.shots.len()),
+        None => (crate::scene::load(&file)?, 1),
+    };
+    let lanes = c.jobs.min(2 * (crate::diagnose::effects::ALL.len() + 1));
+    let pop = Population {
+        option: "--population",
+        size: c
+            .population
+            .max(c.search_population)
+            .max(c.restart_population),
+        copies: lanes.saturating_mul(shots),
+    };
+    let size = (scene.image.width, scene.image.height);
+    crate::scene::memory::check(&file.display().to_string(), size, pop, c.jobs)
 }

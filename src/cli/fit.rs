@@ -90,7 +90,7 @@ pub struct FitArgs {
     nuisance: Vec<crate::scene::Nuisance>,
     /// A set of photographs (--shots): alternations of the shared and the
     /// per-shot blocks at most [default: 4].
-    #[arg(long, value_parser = super::values::positive_count)]
+    #[arg(long, value_parser = super::numbers::positive_count, allow_hyphen_values = true)]
     rounds: Option<usize>,
     /// A set of photographs (--shots): end with one Levenberg–Marquardt
     /// block over the shared and every photograph's own values at once.

@@ -6,13 +6,13 @@ mod demo;
 mod diagnose;
 mod env;
 mod fit;
+mod numbers;
 mod pipeline;
 mod progress;
 mod render;
 mod renderer_args;
 mod report;
 mod search;
-mod values;
 
 use clap::{Parser, Subcommand};
 

@@ -38,11 +38,11 @@ pub struct PipelineArgs {
     #[command(flatten)]
     render_options: super::renderer_args::RendererArgs,
     /// Stage-2 bounds: the stage-1 value ± this fraction of the original span.
-    #[arg(long, default_value_t = 0.15, value_name = "FRACTION")]
+    #[arg(long, default_value_t = 0.15, value_name = "FRACTION", value_parser = super::numbers::number, allow_hyphen_values = true)]
     stage2_window: f64,
     /// Stage-2 start: the population within this radius (unit cube of the
     /// narrowed bounds) of the stage-1 values.
-    #[arg(long, default_value_t = 0.1, value_name = "RADIUS")]
+    #[arg(long, default_value_t = 0.1, value_name = "RADIUS", value_parser = super::numbers::number, allow_hyphen_values = true)]
     stage2_start_radius: f64,
     /// A free parameter that keeps its full bounds in stage 2 (repeatable):
     /// for parameters the two renderers' models read differently.
@@ -86,13 +86,13 @@ struct MethodArgs {
     #[arg(long, value_enum, default_value_t = Stage2Method::Mapped)]
     stage2_method: Stage2Method,
     /// Mapped stage 2: stage-2 renders at most.
-    #[arg(long, default_value_t = MappedBudget::default().fine_renders, value_name = "N")]
+    #[arg(long, default_value_t = MappedBudget::default().fine_renders, value_name = "N", value_parser = super::numbers::positive_count, allow_hyphen_values = true)]
     stage2_fine_renders: usize,
     /// Mapped stage 2: population of each iteration's surrogate fit.
-    #[arg(long, default_value_t = MappedBudget::default().surrogate_population, value_name = "N")]
+    #[arg(long, default_value_t = MappedBudget::default().surrogate_population, value_name = "N", value_parser = super::numbers::positive_count, allow_hyphen_values = true)]
     stage2_surrogate_population: usize,
     /// Mapped stage 2: generations of each iteration's surrogate fit.
-    #[arg(long, default_value_t = MappedBudget::default().surrogate_generations, value_name = "N")]
+    #[arg(long, default_value_t = MappedBudget::default().surrogate_generations, value_name = "N", value_parser = super::numbers::positive_count, allow_hyphen_values = true)]
     stage2_surrogate_generations: usize,
 }
 

@@ -3,6 +3,7 @@
 use crate::error::{Error, Result};
 use crate::raster::io as image_io;
 use crate::render::{from_spec_with, render_one};
+use crate::scene::memory::Population;
 use crate::scene::{load_with, Override};
 use clap::Args;
 use std::path::PathBuf;
@@ -21,13 +22,13 @@ pub struct RenderArgs {
     #[arg(long = "set", value_name = "PARAM=JSON")]
     set: Vec<Override>,
     /// Image width (overrides the scene's).
-    #[arg(long, allow_hyphen_values = true, value_parser = super::values::pixels)]
+    #[arg(long, allow_hyphen_values = true, value_parser = super::numbers::pixels)]
     width: Option<u32>,
     /// Image height (overrides the scene's).
-    #[arg(long, allow_hyphen_values = true, value_parser = super::values::pixels)]
+    #[arg(long, allow_hyphen_values = true, value_parser = super::numbers::pixels)]
     height: Option<u32>,
     /// Sampler seed for sampling renderers.
-    #[arg(long, default_value_t = 0)]
+    #[arg(long, default_value_t = 0, value_parser = super::numbers::seed, allow_hyphen_values = true)]
     seed: u64,
     #[command(flatten)]
     render_options: super::renderer_args::RendererArgs,
@@ -57,6 +58,10 @@ pub fn run(a: RenderArgs) -> Result<()> {
         }
     }
     let scene = load_with(&a.scene, &set)?;
+    // render_one draws one image with one job
+    let size = (scene.image.width, scene.image.height);
+    let file = a.scene.display().to_string();
+    crate::scene::memory::check(&file, size, Population::SINGLE, 1)?;
     let renderer = from_spec_with(&a.renderer, &a.render_options.options()?)?;
     let img = render_one(renderer.as_ref(), &scene, a.seed)?;
     image_io::write_image(&img, &a.output)

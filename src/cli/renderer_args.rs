@@ -26,11 +26,11 @@ enum ExecutorName {
 pub struct RendererArgs {
     /// Seconds one render may take before its process is killed (default:
     /// the backend's; env SCENEFIT_RENDER_TIMEOUT).
-    #[arg(long, value_name = "SECONDS", value_parser = seconds)]
+    #[arg(long, value_name = "SECONDS", value_parser = seconds, allow_hyphen_values = true)]
     render_timeout: Option<Duration>,
     /// Renders a persistent worker serves before it is restarted (default
     /// 200; env SCENEFIT_WORKER_MAX_RENDERS).
-    #[arg(long, value_name = "N", value_parser = at_least_one)]
+    #[arg(long, value_name = "N", value_parser = at_least_one, allow_hyphen_values = true)]
     worker_max_renders: Option<usize>,
     /// The Python that runs the Mitsuba worker (default python3; env
     /// SCENEFIT_PYTHON).
@@ -41,8 +41,8 @@ pub struct RendererArgs {
     #[arg(long, value_enum, default_value_t = ExecutorName::Local)]
     executor: ExecutorName,
     /// Renderer workers (or one-shot processes) at once (default: as many
-    /// as --jobs renders at once).
-    #[arg(long, value_name = "N", value_parser = at_least_one)]
+    /// as --jobs renders at once; at most 65536).
+    #[arg(long, value_name = "N", value_parser = super::numbers::workers, allow_hyphen_values = true)]
     workers: Option<usize>,
     /// Options passed to srun as given, e.g. "--partition=gpu
     /// --time=02:00:00 --gpus-per-task=1" (with --executor slurm).

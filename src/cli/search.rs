@@ -10,7 +10,7 @@
 use crate::error::{Error, Result};
 use crate::fit::FitConfig;
 use crate::optimize::{DeConfig, Strategy};
-use clap::{value_parser, Arg, ArgAction, ArgMatches, Args, Command, FromArgMatches};
+use clap::{Arg, ArgAction, ArgMatches, Args, Command, FromArgMatches};
 use std::marker::PhantomData;
 use std::ops::Deref;
 
@@ -141,16 +141,16 @@ fn arg<K: Kind>(name: &str, help: &str) -> Arg {
 fn args<K: Kind>() -> Vec<Arg> {
     let mut v = vec![
         arg::<K>(POPULATION, "individuals per generation")
-            .value_parser(super::values::positive_count)
+            .value_parser(super::numbers::positive_count)
             .default_value(K::POPULATION.to_string()),
         arg::<K>(GENERATIONS, "generations over all phases")
-            .value_parser(super::values::positive_count)
+            .value_parser(super::numbers::positive_count)
             .default_value(K::GENERATIONS.to_string()),
         arg::<K>(F, "differential weight F (rand1bin)")
-            .value_parser(value_parser!(f64))
+            .value_parser(super::numbers::number)
             .default_value("0.6"),
         arg::<K>(CR, "crossover rate CR (rand1bin)")
-            .value_parser(value_parser!(f64))
+            .value_parser(super::numbers::number)
             .default_value("0.7"),
         arg::<K>(
             STRATEGY,
@@ -162,15 +162,15 @@ fn args<K: Kind>() -> Vec<Arg> {
             SEED,
             "seed of the search: the same seed gives the same result whatever --jobs is",
         )
-        .value_parser(value_parser!(u64))
+        .value_parser(super::numbers::seed)
         .default_value("1"),
         arg::<K>(JOBS, "renders at once (default: the renderer's choice)")
-            .value_parser(super::values::positive_count),
+            .value_parser(super::numbers::positive_count),
         arg::<K>(
             STAGNATION,
             "stop a phase after this many generations without improvement",
         )
-        .value_parser(value_parser!(usize))
+        .value_parser(super::numbers::whole)
         .value_name("GENERATIONS"),
     ];
     if K::ALL_STOPS {
@@ -179,7 +179,7 @@ fn args<K: Kind>() -> Vec<Arg> {
                 TARGET_DEVIATION,
                 "stop once the average deviation (%) is at or below this",
             )
-            .value_parser(value_parser!(f64))
+            .value_parser(super::numbers::number)
             .value_name("PERCENT"),
         );
         v.push(
@@ -187,7 +187,7 @@ fn args<K: Kind>() -> Vec<Arg> {
                 PHASE_GENERATIONS,
                 "generations per phase, e.g. 200,300 (default: an even split)",
             )
-            .value_parser(value_parser!(usize))
+            .value_parser(super::numbers::positive_count)
             .value_name("GENERATIONS")
             .value_delimiter(',')
             .action(ArgAction::Append),

@@ -254,11 +254,21 @@ pub fn clean_ledger(path: &Path) {
         );
         return;
     }
-    let (live, dead): (Vec<String>, Vec<String>) = text
-        .lines()
-        .map(|l| l.trim().to_string())
-        .filter(|l| l.starts_with(NAME_PREFIX))
-        .partition(|p| alive(p));
+    let mut prefixes = Vec::new();
+    for (n, line) in text.lines().enumerate() {
+        match session_prefix(line) {
+            Some(p) => prefixes.push(p.to_string()),
+            None if line.trim().is_empty() => {}
+            // never a wider name: "scenefit-" alone would cancel every
+            // scenefit task of the user
+            None => eprintln!(
+                "scenefit: {}: line {}: ignored; expected a session's task-name prefix {NAME_PREFIX}PID-TIME-N-",
+                path.display(),
+                n + 1
+            ),
+        }
+    }
+    let (live, dead): (Vec<String>, Vec<String>) = prefixes.into_iter().partition(|p| alive(p));
     let ids = cancel_prefixes(&dead);
     if !ids.is_empty() {
         eprintln!(
@@ -271,6 +281,16 @@ pub fn clean_ledger(path: &Path) {
     } else {
         crate::fsio::write_atomic(path, format!("{}\n", live.join("\n")).as_bytes()).is_ok()
     };
+}
+
+/// The line of a ledger as a session's prefix, exactly as `Slurm::new`
+/// writes it (`scenefit-<pid>-<time>-<n>-`); None for anything else.
+fn session_prefix(line: &str) -> Option<&str> {
+    let p = line.trim();
+    let numbers = p.strip_prefix(NAME_PREFIX)?.strip_suffix('-')?;
+    let parts: Vec<&str> = numbers.split('-').collect();
+    let digits = |s: &&str| !s.is_empty() && s.len() <= 20 && s.bytes().all(|b| b.is_ascii_digit());
+    (parts.len() == 3 && parts.iter().all(digits)).then_some(p)
 }
 
 /// The words of `--slurm-args`, split like a shell would.
@@ -316,6 +336,27 @@ mod tests {
         assert_eq!(w.env, spec.env);
         let (_, second) = s.wrap(&spec);
         assert_ne!(task.name, second.name);
+    }
+
+    #[test]
+    fn only_a_whole_session_prefix_is_read_from_a_ledger() {
+        assert_eq!(
+            session_prefix(" scenefit-12-1700000000-0- "),
+            Some("scenefit-12-1700000000-0-")
+        );
+        for bad in [
+            "scenefit-",
+            "scenefit-12-",
+            "scenefit-12-1700000000-",
+            "scenefit-12-1700000000-0",
+            "scenefit-12-1700000000-0-5",
+            "scenefit-a-1-2-",
+            "scenefit-1--2-",
+            "other-1-2-3-",
+            "",
+        ] {
+            assert_eq!(session_prefix(bad), None, "{bad:?}");
+        }
     }
 
     #[test]

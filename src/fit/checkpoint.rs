@@ -114,6 +114,24 @@ impl Checkpoint {
         }
     }
 
+    /// Refuses a checkpoint whose scene declares another image size than
+    /// the run's scene: the size the run's memory was checked for
+    /// (`scene::memory`) is the size it renders at.
+    pub fn check_image(&self, dir: &RunDir, scene: &Scene) -> Result<()> {
+        let (b, s) = (&self.base.image, &scene.image);
+        if (b.width, b.height) == (s.width, s.height) {
+            return Ok(());
+        }
+        Err(Error::invalid(
+            dir.file(CHECKPOINT).display().to_string(),
+            "base.image",
+            format!(
+                "declares {}x{} pixels; expected the scene's {}x{}",
+                b.width, b.height, s.width, s.height
+            ),
+        ))
+    }
+
     pub fn save(&self, dir: &RunDir) -> Result<()> {
         dir.write_json(CHECKPOINT, &self.saved(self.search.as_ref()))
     }

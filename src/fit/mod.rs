@@ -337,6 +337,7 @@ fn initial_state(
         (Some(d), Mode::Resume) => {
             let c = Checkpoint::load(d)?;
             c.check_identity(d, &identity)?;
+            c.check_image(d, scene)?;
             Ok(c)
         }
         _ => Ok(Checkpoint::start(scene.clone(), identity)),

@@ -57,6 +57,11 @@ impl<'a> RenderProblem<'a> {
     }
 
     fn score(&mut self, i: usize, generation: usize, r: RenderResult, want: bool) -> Evaluation {
+        // After Ctrl-C the executor drops the batch: scoring what was
+        // rendered before it would only delay the exit
+        if crate::exec::cancel::is_cancelled() {
+            return Evaluation::failed();
+        }
         let t = &self.target.image;
         match r {
             Ok(img) if img.dimensions() == t.dimensions() => {

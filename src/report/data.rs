@@ -56,6 +56,11 @@ impl Stage {
         let run = RunDir::existing(dir)?;
         let result = FitResult::load(&run)?;
         let fitted = crate::scene::load(&run.file(FITTED_SCENE))?;
+        // the page holds a few images of the fit's size: less than one
+        // render of it, so checked as one
+        let size = (fitted.image.width, fitted.image.height);
+        let file = run.file(FITTED_SCENE).display().to_string();
+        crate::scene::memory::check(&file, size, crate::scene::memory::Population::SINGLE, 1)?;
         let best = run.read_image(BEST)?;
         let (curve, seconds_measured) = match read_trace(&run.file(TRACE))? {
             Some(c) if !c.is_empty() => (c, true),

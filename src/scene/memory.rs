@@ -43,16 +43,37 @@ pub struct Population<'a> {
     /// The option, e.g. `--population` or `--stage2-population`.
     pub option: &'a str,
     pub size: usize,
-    /// How many images each candidate is drawn as (photographs of a set).
+    /// How many images of each candidate are held at once (photographs of
+    /// a set, refits side by side).
     pub copies: usize,
+}
+
+impl Population<'_> {
+    /// One image and no search: `render`.
+    pub const SINGLE: Population<'static> = Population {
+        option: "--population",
+        size: 1,
+        copies: 1,
+    };
+
+    /// The option that sets the renders at once beside this population's:
+    /// `--jobs`, `--stage1-jobs`, ...
+    fn jobs_option(&self) -> String {
+        match self.option.strip_suffix("population") {
+            Some(prefix) if prefix.starts_with("--") => format!("{prefix}jobs"),
+            _ => "--jobs".into(),
+        }
+    }
 }
 
 /// Refuses a fit of a `width` x `height` scene (read from `scene_file`)
 /// with this population and number of jobs when it would need more than
 /// the `avail` bytes the machine has (see [`available`]; None: unknown,
-/// nothing checked). The error names what to lower: the population when
-/// it is the larger share (by the option that set it), else the scene's
-/// image size.
+/// nothing checked). The one check of every command that renders (render,
+/// fit, a set fit, pipeline, diagnose, demo, a resume), made before
+/// anything of that size is allocated. The error names what to lower: the
+/// largest share of the estimate, as the option that set it (population,
+/// jobs) or the scene's image size.
 pub fn check_fit(
     avail: Option<f64>,
     scene_file: &str,
@@ -61,44 +82,60 @@ pub fn check_fit(
     jobs: usize,
 ) -> Result<()> {
     let Some(avail) = avail else { return Ok(()) };
-    let Population {
-        option,
-        size: population,
-        copies,
-    } = pop;
-    let candidates = population * copies.max(1);
+    let copies = pop.copies.max(1);
+    let candidates = pop.size.saturating_mul(copies);
     let need = estimate(width, height, candidates, jobs);
     if need <= avail {
         return Ok(());
     }
     let gib = |b: f64| b / (1024.0 * 1024.0 * 1024.0);
     let px = width as f64 * height as f64;
+    let image = estimate(width, height, 0, 0);
     let per_individual = px * PER_PIXEL_INDIVIDUAL + PER_INDIVIDUAL;
-    let fixed = estimate(width, height, 0, jobs);
-    if candidates as f64 * per_individual >= fixed {
-        let fits = ((avail - fixed) / per_individual / copies.max(1) as f64)
-            .floor()
-            .max(0.0);
+    let population = candidates as f64 * per_individual;
+    let renders = px * PER_PIXEL_JOB * jobs as f64;
+    let needs = format!(
+        "would need about {:.1} GiB, {:.1} GiB is available",
+        gib(need),
+        gib(avail)
+    );
+    // What fits of one share with the others as they are.
+    let fits = |share: f64, each: f64| ((avail - (need - share)) / each).floor().max(0.0);
+    if renders > population && renders > image {
+        let (option, most) = (pop.jobs_option(), fits(renders, px * PER_PIXEL_JOB));
+        return Err(Error::Usage(format!(
+            "{option} {jobs}: {jobs} renders at once of {width}x{height} pixels {needs}; expected {option} up to {most}"
+        )));
+    }
+    if population >= image {
+        let most = (fits(population, per_individual) / copies as f64).floor();
         let each = if copies > 1 {
-            format!(" (each candidate drawn for {copies} photographs)")
+            format!(" ({copies} images of each candidate at once)")
         } else {
             String::new()
         };
         return Err(Error::Usage(format!(
-            "{option} {population}: a fit of {width}x{height} pixels{each} would need about {:.1} GiB, {:.1} GiB is available; expected a population up to {fits}",
-            gib(need),
-            gib(avail)
+            "{} {}: a fit of {width}x{height} pixels{each} {needs}; expected a population up to {most}",
+            pop.option, pop.size
         )));
     }
     Err(Error::invalid(
         scene_file,
         "image.width",
         format!(
-            "a fit of {width}x{height} pixels with population {population} would need about {:.1} GiB, {:.1} GiB is available; expected a smaller image",
-            gib(need),
-            gib(avail)
+            "{width}x{height} pixels{} {needs}; expected a smaller image",
+            if pop.size > 1 {
+                format!(" with population {}", pop.size)
+            } else {
+                String::new()
+            }
         ),
     ))
+}
+
+/// [`check_fit`] against the memory available now.
+pub fn check(scene_file: &str, size: (u32, u32), pop: Population, jobs: usize) -> Result<()> {
+    check_fit(available(), scene_file, size, pop, jobs)
 }
 
 #[cfg(test)]
@@ -164,7 +201,7 @@ mod tests {
             let m = e.to_string();
             m.rsplit(' ').next().unwrap().parse().unwrap()
         };
-        assert!(many.to_string().contains("24 photographs"), "{many}");
+        assert!(many.to_string().contains("24 images of each"), "{many}");
         assert!(
             (fits(&one) / fits(&many) - 24.0).abs() < 0.01,
             "{one} / {many}"
@@ -175,6 +212,46 @@ mod tests {
     fn the_largest_image_names_the_scene_key() {
         let e = refusal(16384, 16384, 10);
         assert!(e.starts_with("s.json: image.width:"), "{e}");
+    }
+
+    #[test]
+    fn huge_jobs_name_the_jobs_option() {
+        let e = check_fit(Some(8.0 * GIB), "s.json", (128, 96), pop(80), 1_000_000_000)
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("--jobs 1000000000:"), "{e}");
+        let p = Population {
+            option: "--stage2-population",
+            size: 8,
+            copies: 1,
+        };
+        let e = check_fit(Some(8.0 * GIB), "s.json", (128, 96), p, 1_000_000_000).unwrap_err();
+        assert!(
+            e.to_string().starts_with("--stage2-jobs 1000000000:"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn a_single_render_of_a_huge_image_names_the_scene_key() {
+        let e = check_fit(
+            Some(8.0 * GIB),
+            "s.json",
+            (16384, 16384),
+            Population::SINGLE,
+            1,
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(e.starts_with("s.json: image.width:"), "{e}");
+        assert!(check_fit(
+            Some(8.0 * GIB),
+            "s.json",
+            (4096, 4096),
+            Population::SINGLE,
+            2
+        )
+        .is_ok());
     }
 
     #[test]

@@ -125,6 +125,16 @@ fn read(path: &Path, file: &str) -> Result<ShotsFile> {
     })?;
     let text = String::from_utf8_lossy(&bytes);
     let text = text.strip_prefix('\u{feff}').unwrap_or(&text);
+    // serde reads a struct from an array too, and then names an element
+    if !text.trim_start().starts_with('{')
+        && serde_json::from_str::<serde::de::IgnoredAny>(text).is_ok()
+    {
+        return Err(Error::invalid(
+            file,
+            "(top level)",
+            format!("expected a JSON object {{\"format\": \"{FORMAT}\", \"shots\": [...]}}"),
+        ));
+    }
     let de = &mut serde_json::Deserializer::from_str(text);
     let parsed: ShotsFile = serde_path_to_error::deserialize(de).map_err(|e| {
         let key = e.path().to_string();
@@ -162,6 +172,35 @@ fn read(path: &Path, file: &str) -> Result<ShotsFile> {
     Ok(parsed)
 }
 
+/// A shot's scene refused with its `set` values: the error names the
+/// shots file, the shot and the `set` key whose value alone is refused
+/// (the scene's own key path in the message), or the shot's whole `set`.
+fn blame_set(e: Error, scene: &Scene, overrides: &[Override], file: &str, at: &str) -> Error {
+    let Error::Invalid { key, message, .. } = e else {
+        return e;
+    };
+    // an override that could not be applied is named already, by its path
+    if let Some(path) = key.strip_prefix(&format!("{at}.")) {
+        return Error::invalid(file, format!("{at}.set.{path}"), message);
+    }
+    for o in overrides {
+        if let Err(Error::Invalid { key, message, .. }) =
+            with_overrides(scene, std::slice::from_ref(o), file, at)
+        {
+            return Error::invalid(
+                file,
+                format!("{at}.set.{}", o.path),
+                format!("{message} (the scene's {key})"),
+            );
+        }
+    }
+    Error::invalid(
+        file,
+        format!("{at}.set"),
+        format!("{message} (the scene's {key})"),
+    )
+}
+
 /// One entry checked and loaded: its scene, its target, its mask.
 fn shot(
     mut e: Entry,
@@ -187,7 +226,8 @@ fn shot(
             value: value.clone(),
         });
     }
-    let shot_scene = with_overrides(scene, &overrides, file, at)?;
+    let shot_scene = with_overrides(scene, &overrides, file, at)
+        .map_err(|e| blame_set(e, scene, &overrides, file, at))?;
     e.target = dir.join(&e.target);
     e.mask = e.mask.map(|m| dir.join(m));
     let encoding = e

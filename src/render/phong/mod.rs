@@ -24,8 +24,9 @@ mod packed;
 mod paths;
 mod shade;
 
-use super::{Image, RenderResult, RenderSession, Renderer};
+use super::{Image, RenderFailure, RenderResult, RenderSession, Renderer};
 use crate::error::{Error, Result};
+use crate::exec::cancel;
 use crate::scene::{ParamSpace, Scene};
 use packed::Packed;
 use paths::{Paths, Variation};
@@ -89,6 +90,13 @@ struct PhongSession {
 
 impl PhongSession {
     fn render(&self, scene: &Scene) -> RenderResult {
+        // Ctrl-C (exec::cancel) ends a batch within one pass of one render:
+        // the rest of the batch is not drawn, and a render cut short (or
+        // drawn from paths whose tracing was cut short) is a failure,
+        // never an image.
+        if cancel::is_cancelled() {
+            return Err(RenderFailure::new(cancel::MESSAGE));
+        }
         let (w, h) = (scene.image.width, scene.image.height);
         let mut buf = vec![0u8; (w * h * 3) as usize];
         let maps = shade::albedo_maps(scene)?;
@@ -98,6 +106,9 @@ impl PhongSession {
                 let p = Prepared::new(scene, &self.variation, false);
                 shade::shade(&p.paths, &p.packed, scene, &maps, &mut buf)
             }
+        }
+        if cancel::is_cancelled() {
+            return Err(RenderFailure::new(cancel::MESSAGE));
         }
         Ok(Image::from_raw(w, h, buf).expect("buffer sized to the image"))
     }

@@ -137,7 +137,8 @@ impl Paths {
                 occluders: Vec::new(),
                 budget: 0,
             };
-            for y in rows {
+            // cut short on Ctrl-C: every render then fails (mod.rs)
+            for y in rows.take_while(|_| !crate::exec::cancel::is_cancelled()) {
                 for x in Geometry::row_span(&rects, y as f64, (y + 1) as f64, w) {
                     for sy in 0..aa {
                         for sx in 0..aa {

@@ -139,10 +139,13 @@ fn shade_into(
     if maps.iter().all(Option::is_none) {
         for (l, light) in scene.lights.iter().enumerate() {
             let lamp = lamp(light);
-            if lamp.power == [0.0; 3] {
+            if lamp.power == [0.0; 3] || cancelled() {
                 continue;
             }
             light_visibility(paths, packed, l, &lamp, e, nh);
+            if cancelled() {
+                return;
+            }
             add_diffuse(packed, &mats, &lamp, e, r, g, b);
             add_specular(packed, &mats, &lamp, e, nh, r, g, b);
         }
@@ -152,10 +155,13 @@ fn shade_into(
         let (mut sr, mut sg, mut sb) = (vec![0f32; n], vec![0f32; n], vec![0f32; n]);
         for (l, light) in scene.lights.iter().enumerate() {
             let lamp = lamp(light);
-            if lamp.power == [0.0; 3] {
+            if lamp.power == [0.0; 3] || cancelled() {
                 continue;
             }
             light_visibility(paths, packed, l, &lamp, e, nh);
+            if cancelled() {
+                return;
+            }
             add_diffuse(packed, &mats, &lamp, e, r, g, b);
             add_specular(packed, &mats, &lamp, e, nh, &mut sr, &mut sg, &mut sb);
         }
@@ -166,14 +172,28 @@ fn shade_into(
             b[i] += sb[i];
         }
     }
+    if cancelled() {
+        return;
+    }
     if let Some(k) = scene.indirect_light.filter(|&k| k > 0.0) {
         let albedo: Vec<[f32; 3]> = mats.iter().map(|m| m.diffuse).collect();
         super::effects::one_bounce(packed, &albedo, k as f32, r, g, b);
+    }
+    if cancelled() {
+        return;
     }
     match &packed.direct_pixel {
         Some(pixel) => encode_direct(packed.n, pixel, r, g, b, out),
         None => encode_paths(paths, packed, &mats, r, g, b, out),
     }
+}
+
+/// Whether Ctrl-C was pressed (`exec::cancel`). Checked between the
+/// passes over every pixel, each a fraction of a render: a shading cut
+/// short leaves the image unfinished, and the render then fails (mod.rs).
+#[inline(always)]
+fn cancelled() -> bool {
+    crate::exec::cancel::is_cancelled()
 }
 
 /// Every hit starts from its material's ambient term.
