@@ -229,11 +229,7 @@ const INPUTS: &[Input] = &[
 /// Rows whose command does not read the file yet, with why: each of their
 /// cases must still fail, so that the row is taken off this list (and
 /// checked like the others) once the command reads it.
-const PENDING: &[(&str, &str, &str)] = &[(
-    "fit --shots --resume",
-    "setrun/set_state.json",
-    "a set fit's --resume looks for checkpoint.json, not set_state.json (issue 30, set fits resumable)",
-)];
+const PENDING: &[(&str, &str, &str)] = &[];
 
 /// One hostile stand-in: writes itself at `path` in place of `valid` (the
 /// file's real contents); `outside` is a directory beside the case's.

@@ -15,7 +15,7 @@ use std::time::{Duration, Instant};
 /// per photograph.
 const SCENE: &str = r#"{
   "format": "scenefit-scene/1",
-  "image": {"width": 24, "height": 18},
+  "image": {"width": 64, "height": 48},
   "camera": {"type": "perspective", "position": [0, 1.5, 5], "look_at": [0, 0.5, 0],
              "up": [0, 1, 0], "fov_y_deg": 40},
   "lights": [{"name": "key", "type": "point", "position": [1, 3, 2], "color": [1, 1, 1],
@@ -150,7 +150,7 @@ fn a_set_fit_killed_at_random_moments_resumes_to_the_same_result() {
     let mut moments = Moments(seed);
     let killed = d.path().join("killed");
     let mut kills = 0;
-    for _ in 0..8 {
+    for _ in 0..12 {
         if killed.join("result.json").exists() {
             break;
         }
@@ -166,8 +166,9 @@ fn a_set_fit_killed_at_random_moments_resumes_to_the_same_result() {
             .stderr(std::process::Stdio::null())
             .spawn()
             .unwrap();
-        // At most a third of a run: every run but the last is killed.
-        std::thread::sleep(Duration::from_millis(20 + moments.below(run_ms / 3)));
+        // At most a quarter of a run (a resumed run has less left to do):
+        // every run but the last is killed.
+        std::thread::sleep(Duration::from_millis(5 + moments.below(run_ms / 4)));
         if child.try_wait().unwrap().is_none() {
             kills += 1;
         }

@@ -236,8 +236,13 @@ pub fn clean_ledger(path: &Path) {
     // bounded: the ledger is read on every run, whatever stands in its place
     let text = match crate::input::read_text_capped(path, crate::input::MAX_TEXT_BYTES) {
         Ok(t) => t,
+        // No ledger, or no directory to hold one (the run itself refuses
+        // an output that is not a directory, in its own words).
         Err(crate::error::Error::Io { source, .. })
-            if source.kind() == std::io::ErrorKind::NotFound =>
+            if matches!(
+                source.kind(),
+                std::io::ErrorKind::NotFound | std::io::ErrorKind::NotADirectory
+            ) =>
         {
             return
         }

@@ -108,8 +108,8 @@ impl Checkpoint {
         match self.identity.mismatch(now) {
             None => Ok(()),
             Some(what) => Err(Error::Usage(format!(
-                "cannot resume the run in {}: {what}; resume with the same inputs and options, or start afresh with --overwrite",
-                dir.path().display()
+                "cannot resume the run saved in {}: {what}; resume with the same inputs and options, or start afresh with --overwrite",
+                dir.file(CHECKPOINT).display()
             ))),
         }
     }

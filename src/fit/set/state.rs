@@ -127,8 +127,7 @@ impl SetState {
         let now = identities(shots, renderer, config);
         let refuse = |what: String| {
             Error::Usage(format!(
-                "cannot resume the run in {}: {what}; resume with the same inputs and options, or start afresh with --overwrite",
-                dir.path().display()
+                "cannot resume the run saved in {file}: {what}; resume with the same inputs and options, or start afresh with --overwrite"
             ))
         };
         if s.identities.len() != now.len() {
