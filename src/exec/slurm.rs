@@ -62,11 +62,11 @@ impl Task {
         let Some(path) = &self.stderr else {
             return String::new();
         };
-        let Ok(bytes) = std::fs::read(path) else {
+        // bounded: only the tail is read, whatever the task wrote
+        let Ok(keep) = crate::input::read_tail(path, super::tail::TAIL_BYTES as u64) else {
             return String::new();
         };
-        let keep = &bytes[bytes.len().saturating_sub(super::tail::TAIL_BYTES)..];
-        String::from_utf8_lossy(keep).into_owned()
+        String::from_utf8_lossy(&keep).into_owned()
     }
 }
 

@@ -103,6 +103,20 @@ pub fn read_capped(path: &Path, limit: u64) -> std::result::Result<Vec<u8>, Capp
     Ok(bytes)
 }
 
+/// Reads the last `n` bytes (at most) of the regular file `path`,
+/// whatever its size: the tail of a log another program writes.
+pub fn read_tail(path: &Path, n: u64) -> std::result::Result<Vec<u8>, CappedRead> {
+    use std::io::{Seek, SeekFrom};
+    let (mut file, len) = open_regular(path)?;
+    file.seek(SeekFrom::Start(len.saturating_sub(n)))
+        .map_err(CappedRead::Io)?;
+    let mut bytes = Vec::with_capacity(n.min(len) as usize);
+    file.take(n)
+        .read_to_end(&mut bytes)
+        .map_err(CappedRead::Io)?;
+    Ok(bytes)
+}
+
 /// Reads a text file the tool wrote, of at most `limit` bytes.
 pub fn read_text_capped(path: &Path, limit: u64) -> Result<String> {
     let bytes =
@@ -129,6 +143,20 @@ pub fn capped_error(path: &Path, e: CappedRead, expected: &str) -> Error {
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn a_tail_is_read_from_the_end_of_any_size_of_file() {
+        let d = tempfile::tempdir().unwrap();
+        let small = d.path().join("small.log");
+        std::fs::write(&small, b"abcdef").unwrap();
+        assert_eq!(read_tail(&small, 4).unwrap(), b"cdef");
+        assert_eq!(read_tail(&small, 100).unwrap(), b"abcdef");
+        // sparse: 20 GB declared, only the tail is read
+        let huge = d.path().join("huge.log");
+        let f = std::fs::File::create(&huge).unwrap();
+        f.set_len(20 << 30).unwrap();
+        assert_eq!(read_tail(&huge, 8).unwrap(), vec![0u8; 8]);
+    }
+
     use super::*;
     use std::time::{Duration, Instant};
 
