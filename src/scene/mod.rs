@@ -3,6 +3,7 @@
 //! parameter space that maps the `free` list to a search vector and back.
 
 pub mod albedo_map;
+mod checks;
 pub mod color;
 pub mod field;
 pub mod limits;

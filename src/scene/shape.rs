@@ -5,7 +5,9 @@
 //! geometry, the POV-Ray writer). Free parameters reach a shape's numbers
 //! by field name through [`Shape::fields`] and [`Shape::fields_mut`].
 
-use crate::math::Vec3;
+use super::checks::{finite3, nonzero3, positive};
+use crate::error::{Error, Result};
+use crate::math::{Vec3, V3};
 use serde::{Deserialize, Serialize};
 
 /// A surface. Every field is required; unknown fields are refused.
@@ -75,6 +77,66 @@ impl Shape {
                 edge_v,
             } => vec![("corner", corner), ("edge_u", edge_u), ("edge_v", edge_v)],
             Shape::Box { min, max } => vec![("min", min), ("max", max)],
+        }
+    }
+
+    /// Refuses values the types cannot rule out (a negative radius, a
+    /// zero normal), naming `file` and the key under `at`.
+    pub fn check(&self, file: &str, at: &str) -> Result<()> {
+        let key = |k: &str| format!("{at}.{k}");
+        let finite = |k: &str, v: Vec3| -> Result<()> {
+            if !finite3(v) {
+                return Err(Error::invalid(file, key(k), "expected finite numbers"));
+            }
+            Ok(())
+        };
+        match *self {
+            Shape::Sphere { center, radius } => {
+                finite("center", center)?;
+                positive(file, &key("radius"), radius)
+            }
+            Shape::Plane { point, normal } => {
+                finite("point", point)?;
+                nonzero3(file, &key("normal"), normal)
+            }
+            Shape::Quad {
+                corner,
+                edge_u,
+                edge_v,
+            } => {
+                finite("corner", corner)?;
+                nonzero3(file, &key("edge_u"), edge_u)?;
+                nonzero3(file, &key("edge_v"), edge_v)?;
+                if V3::from(edge_u).cross(V3::from(edge_v)).length() < 1e-12 {
+                    return Err(Error::invalid(
+                        file,
+                        key("edge_v"),
+                        "is parallel to edge_u; expected two edges that span a parallelogram",
+                    ));
+                }
+                Ok(())
+            }
+            Shape::Box { min, max } => {
+                finite("min", min)?;
+                finite("max", max)?;
+                if (0..3).any(|a| min[a] >= max[a]) {
+                    return Err(Error::invalid(
+                        file,
+                        key("max"),
+                        format!("expected every component above min {min:?}, got {max:?}"),
+                    ));
+                }
+                Ok(())
+            }
+        }
+    }
+
+    /// True when the shape stays itself under a scale per axis (a sphere
+    /// would become an ellipsoid, which is not drawn).
+    pub fn takes_axis_scales(&self) -> bool {
+        match self {
+            Shape::Sphere { .. } => false,
+            Shape::Plane { .. } | Shape::Quad { .. } | Shape::Box { .. } => true,
         }
     }
 

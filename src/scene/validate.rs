@@ -3,6 +3,7 @@
 //! names, free parameters that name nothing or have bad bounds. Every error
 //! names the key path and what was expected.
 
+use super::checks::{finite3, non_negative, non_negative3, nonzero3, positive};
 use super::field::{Field, Value};
 use super::limits::*;
 use super::types::*;
@@ -137,7 +138,7 @@ fn objects(scene: &Scene, file: &str) -> Result<()> {
                 format!("duplicate object name \"{}\"", o.name),
             );
         }
-        shape(&o.shape, file, &format!("{at}.shape"))?;
+        o.shape.check(file, &format!("{at}.shape"))?;
         if let Some(t) = &o.transform {
             transform(t, &o.shape, file, &format!("{at}.transform"))?;
         }
@@ -159,54 +160,6 @@ fn free_list(scene: &Scene, file: &str) -> Result<()> {
             );
         }
         free(scene, f, file, &at)?;
-    }
-    Ok(())
-}
-
-fn finite3(v: Vec3) -> bool {
-    v.iter().all(|x| x.is_finite())
-}
-
-fn non_negative3(file: &str, key: &str, v: Vec3) -> Result<()> {
-    if !finite3(v) || v.iter().any(|&x| x < 0.0) {
-        return Err(Error::invalid(
-            file,
-            key,
-            format!("expected three non-negative numbers, got {v:?}"),
-        ));
-    }
-    Ok(())
-}
-
-fn non_negative(file: &str, key: &str, x: f64) -> Result<()> {
-    if !x.is_finite() || x < 0.0 {
-        return Err(Error::invalid(
-            file,
-            key,
-            format!("expected a non-negative number, got {x}"),
-        ));
-    }
-    Ok(())
-}
-
-fn positive(file: &str, key: &str, x: f64) -> Result<()> {
-    if !x.is_finite() || x <= 0.0 {
-        return Err(Error::invalid(
-            file,
-            key,
-            format!("expected a positive number, got {x}"),
-        ));
-    }
-    Ok(())
-}
-
-fn nonzero3(file: &str, key: &str, v: Vec3) -> Result<()> {
-    if !finite3(v) || V3::from(v).length() < 1e-12 {
-        return Err(Error::invalid(
-            file,
-            key,
-            format!("expected a non-zero vector, got {v:?}"),
-        ));
     }
     Ok(())
 }
@@ -386,56 +339,6 @@ fn light(l: &Light, file: &str, at: &str) -> Result<()> {
     }
 }
 
-/// A shape's values; which fields it has the types already decide.
-fn shape(s: &Shape, file: &str, at: &str) -> Result<()> {
-    let key = |k: &str| format!("{at}.{k}");
-    let finite = |k: &str, v: Vec3| -> Result<()> {
-        if !finite3(v) {
-            return Err(Error::invalid(file, key(k), "expected finite numbers"));
-        }
-        Ok(())
-    };
-    match *s {
-        Shape::Sphere { center, radius } => {
-            finite("center", center)?;
-            positive(file, &key("radius"), radius)
-        }
-        Shape::Plane { point, normal } => {
-            finite("point", point)?;
-            nonzero3(file, &key("normal"), normal)
-        }
-        Shape::Quad {
-            corner,
-            edge_u,
-            edge_v,
-        } => {
-            finite("corner", corner)?;
-            nonzero3(file, &key("edge_u"), edge_u)?;
-            nonzero3(file, &key("edge_v"), edge_v)?;
-            if V3::from(edge_u).cross(V3::from(edge_v)).length() < 1e-12 {
-                return Err(Error::invalid(
-                    file,
-                    key("edge_v"),
-                    "is parallel to edge_u; expected two edges that span a parallelogram",
-                ));
-            }
-            Ok(())
-        }
-        Shape::Box { min, max } => {
-            finite("min", min)?;
-            finite("max", max)?;
-            if (0..3).any(|a| min[a] >= max[a]) {
-                return Err(Error::invalid(
-                    file,
-                    key("max"),
-                    format!("expected every component above min {min:?}, got {max:?}"),
-                ));
-            }
-            Ok(())
-        }
-    }
-}
-
 /// Finite numbers and positive scales; one scale for a sphere (a
 /// stretched sphere, an ellipsoid, is not drawn).
 fn transform(t: &Transform, s: &Shape, file: &str, at: &str) -> Result<()> {
@@ -454,19 +357,18 @@ fn transform(t: &Transform, s: &Shape, file: &str, at: &str) -> Result<()> {
     for x in scale.axes() {
         positive(file, &format!("{at}.scale"), x)?;
     }
-    match s {
-        Shape::Sphere { .. } if scale.uniform().is_none() => Err(Error::invalid(
+    if scale.uniform().is_none() && !s.takes_axis_scales() {
+        return Err(Error::invalid(
             file,
             format!("{at}.scale"),
             format!(
-                "a sphere takes one scale for every axis (an ellipsoid is not drawn); expected a number, got {:?}",
-                scale.axes()
+                "a {t} takes one scale for every axis (scaled per axis it would no longer be a {t}); expected a number, got {:?}",
+                scale.axes(),
+                t = s.type_name()
             ),
-        )),
-        Shape::Sphere { .. } | Shape::Plane { .. } | Shape::Quad { .. } | Shape::Box { .. } => {
-            Ok(())
-        }
+        ));
     }
+    Ok(())
 }
 
 fn material(m: &Material, file: &str, at: &str) -> Result<()> {
