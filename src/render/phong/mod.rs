@@ -77,6 +77,7 @@ struct Prepared {
 impl Prepared {
     fn new(scene: &Scene, variation: &Variation, parallel: bool) -> Prepared {
         let paths = Paths::build(scene, variation, parallel);
+        // A cancelled build is empty (paths.rs): packing it costs nothing.
         let packed = Packed::new(&paths, scene.lights.len());
         Prepared { paths, packed }
     }
@@ -104,6 +105,10 @@ impl PhongSession {
             Some(p) => shade::shade(&p.paths, &p.packed, scene, &maps, &mut buf),
             None => {
                 let p = Prepared::new(scene, &self.variation, false);
+                // a cancelled build is cut short, never shaded
+                if cancel::is_cancelled() {
+                    return Err(RenderFailure::new(cancel::MESSAGE));
+                }
                 shade::shade(&p.paths, &p.packed, scene, &maps, &mut buf)
             }
         }

@@ -166,8 +166,15 @@ impl Paths {
             vec![trace_rows(0..h)]
         };
         // The first part is taken as it is; the others are appended to it.
+        // Cut short on Ctrl-C too: on a large image the appending and the
+        // packing after it take seconds, and what is left of a cancelled
+        // build is never drawn (mod.rs), so it is left empty.
+        let cancelled = crate::exec::cancel::is_cancelled;
         let mut parts = parts.into_iter();
-        let (verts, shadow, occluders) = parts.next().unwrap_or_default();
+        let (verts, shadow, occluders) = match cancelled() {
+            false => parts.next().unwrap_or_default(),
+            true => Default::default(),
+        };
         let mut paths = Paths {
             width: w,
             height: h,
@@ -178,6 +185,12 @@ impl Paths {
             geometry,
         };
         for (verts, shadow, occluders) in parts {
+            if cancelled() {
+                paths.verts.clear();
+                paths.shadow.clear();
+                paths.occluders.clear();
+                break;
+            }
             let base_v = paths.verts.len() as u32;
             let base_o = paths.occluders.len() as u32;
             paths.verts.extend(verts.into_iter().map(|mut v| {
