@@ -47,8 +47,11 @@ impl Renderer for Phong {
         varying: &ParamSpace,
         jobs: usize,
     ) -> Result<Box<dyn RenderSession>> {
+        // The tracer is CPU-bound: threads beyond the cores only cost (a
+        // huge --jobs once started 50,000 threads and stalled the machine).
+        // The result does not depend on the thread count.
         let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(jobs.max(1))
+            .num_threads(jobs.clamp(1, self.default_jobs()))
             .build()
             .map_err(|e| Error::Run(format!("phong: cannot start threads: {e}")))?;
         let variation = Variation::new(base, varying);
