@@ -450,6 +450,32 @@ mod tests {
         );
     }
 
+    /// A mesh is written as `mesh2` from the triangles read (z mirrored,
+    /// vertex normals kept, a quad fanned into two triangles), numbers only.
+    #[test]
+    fn a_mesh_is_written_as_mesh2() {
+        let d = tempfile::tempdir().unwrap();
+        let ply = d.path().join("q.ply");
+        let head = "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\nproperty float nx\nproperty float ny\nproperty float nz\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n";
+        let body = "0 0 1 0 0 1\n1 0 1 0 0 1\n1 1 1 0 0 1\n0 1 1 0 0 1\n4 0 1 2 3\n";
+        std::fs::write(&ply, format!("{head}{body}")).unwrap();
+        let mut scene = crate::scene::test_scene::ball(r#""color": [0.5, 0.5, 0.5]"#, "");
+        scene.objects[0].shape = Shape::Mesh {
+            file: ply.display().to_string(),
+        };
+        let out = sdl(&scene).unwrap();
+        assert!(
+            out.contains("mesh2 {\n  vertex_vectors { 4, <0, 0, -1e0>, <1e0, 0, -1e0>"),
+            "{out}"
+        );
+        assert!(out.contains("normal_vectors { 4, <0, 0, -1e0>"), "{out}");
+        assert!(
+            out.contains("face_indices { 2, <0, 1, 2>, <0, 2, 3> }"),
+            "{out}"
+        );
+        assert!(!out.contains("q.ply"), "the path is not written: {out}");
+    }
+
     #[test]
     fn numbers_povray_reads() {
         assert_eq!(num(0.0), "0");
