@@ -223,7 +223,32 @@ def structure_of(desc):
     """The part of a described scene that decides which datablocks exist."""
     return (desc["camera"]["type"],
             tuple((L["name"], L["type"], falloff_kind(L)) for L in desc["lights"]),
-            tuple((o["name"], o["shape"]["type"], o["material"]["kind"]) for o in desc["objects"]))
+            tuple((o["name"], o["shape"]["type"], o["material"]["kind"], o["shape"].get("file"))
+                  for o in desc["objects"]))
+
+
+def import_mesh(path, name, where):
+    """The mesh file scenefit read, imported with Blender's own importer as
+    one mesh in Blender's frame (the scene's y up turned to z up, as B()),
+    smooth-shaded when the file gives vertex normals."""
+    before = set(bpy.data.objects)
+    try:
+        if path.lower().endswith(".obj"):
+            bpy.ops.wm.obj_import(filepath=path, forward_axis="Y", up_axis="Z")
+        else:
+            bpy.ops.import_mesh.ply(filepath=path)
+    except Exception as e:  # an importer reports a bad file as RuntimeError
+        raise SceneError("%s: Blender could not import %s: %s" % (where, path, str(e).strip()))
+    new = [o for o in bpy.data.objects if o not in before and o.type == "MESH"]
+    if len(new) != 1:
+        raise SceneError("%s: expected one mesh in %s, Blender imported %d" % (where, path, len(new)))
+    me = new[0].data
+    bpy.data.objects.remove(new[0], do_unlink=True)
+    me.name = PREFIX + "mesh_" + name
+    me.transform(Matrix.Rotation(math.pi / 2, 4, "X"))
+    if not me.materials:
+        me.materials.append(None)
+    return me
 
 
 # ---------------------------------------------------------------------------
@@ -448,7 +473,7 @@ class Worker:
             self.lights.append((lo, fnode))
 
         # objects
-        for i, (name, stype, mkind) in enumerate(obj_structs):
+        for i, (name, stype, mkind, file) in enumerate(obj_structs):
             where = "object '%s'" % name
             own_mesh = None
             if stype in ("sphere", "plane", "box"):
@@ -457,6 +482,9 @@ class Worker:
                 me = bpy.data.meshes.new(PREFIX + "quad_" + name)
                 me.from_pydata([(0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0)], [], [(0, 1, 2, 3)])
                 me.materials.append(None)
+                own_mesh = me
+            elif stype == "mesh":
+                me = import_mesh(file, name, where)
                 own_mesh = me
             else:
                 raise SceneError("%s: shape.type must be sphere, plane, quad or box, got %r" % (where, stype))

@@ -62,6 +62,37 @@ fn mitsuba_agrees_with_phong() {
     }
 }
 
+/// The diffuse scene with its ball replaced by the example blob mesh
+/// (1280 triangles with vertex normals), drawn by `renderer` and by the
+/// built-in tracer (deviation in percent).
+fn mesh_agreement(renderer: &str) -> f64 {
+    let mut v = diffuse_scene(64, 4);
+    let ply = root().join("scenes/mesh_blob.ply");
+    v["objects"][0]["shape"] = serde_json::json!({"type": "mesh", "file": ply});
+    let phong = render_one(from_spec("phong").unwrap().as_ref(), &scene(&v), 0).expect("phong");
+    let other = render_one(from_spec(renderer).unwrap().as_ref(), &scene(&v), 7)
+        .unwrap_or_else(|e| panic!("{renderer}: {e}"));
+    let d = deviation(&phong, &other, None);
+    eprintln!(
+        "{renderer} vs phong on a mesh: deviation {:.3} %",
+        d.average
+    );
+    d.average
+}
+
+#[test]
+fn every_backend_draws_a_mesh_as_the_built_in_tracer_does() {
+    if have("povray", "POV-Ray") {
+        assert!(mesh_agreement("povray") <= 0.5);
+    }
+    if have("blender", "Blender") {
+        assert!(mesh_agreement("blender") <= 0.5);
+    }
+    if have_mitsuba() {
+        assert!(mesh_agreement("mitsuba") <= 0.5);
+    }
+}
+
 /// The diffuse scene's key light written as a near light (a directional
 /// light with a distance, render/near_lights.rs) at the same place and with
 /// the same irradiance at the origin: `renderer` draws what it draws for the

@@ -27,6 +27,8 @@ enum Kind {
     Image,
     Exr,
     Font,
+    /// A mesh shape's file (PLY).
+    Mesh,
 }
 
 /// One file a command reads: the command line (run in a copy of the
@@ -47,6 +49,20 @@ const G: &[&str] = &["-q", "--population", "6", "--generations", "2"];
 /// Commands x the files they read, one entry each. `demo` reads no
 /// file (its scene and targets are built in), so it has no entry.
 const INPUTS: &[Input] = &[
+    Input {
+        label: "render",
+        args: &["render", "sm.json", "-o", "out.png"],
+        file: "m.ply",
+        kind: Kind::Mesh,
+        output: "out.png",
+    },
+    Input {
+        label: "fit",
+        args: &["fit", "sm.json", "--target", "t.png", "-o", "out"],
+        file: "m.ply",
+        kind: Kind::Mesh,
+        output: "out",
+    },
     Input {
         label: "render",
         args: &["render", "s.json", "-o", "out.png"],
@@ -299,7 +315,9 @@ fn mkfifo(p: &Path) {
 fn wrong_format(kind: Kind) -> Vec<u8> {
     match kind {
         Kind::Json => png_header(4, 4),
-        Kind::Image | Kind::Exr | Kind::Font => br#"{"not": "this kind of file"}"#.to_vec(),
+        Kind::Image | Kind::Exr | Kind::Font | Kind::Mesh => {
+            br#"{"not": "this kind of file"}"#.to_vec()
+        }
     }
 }
 
@@ -310,6 +328,12 @@ fn huge_declared(kind: Kind, valid: &[u8]) -> Vec<u8> {
     match kind {
         Kind::Image | Kind::Exr => png_header(100_000, 100_000),
         Kind::Font => [0u8, 1, 0, 0, 0xff, 0xff, 0, 0, 0, 0, 0, 0].to_vec(),
+        // 2^31 faces declared in a few hundred bytes
+        Kind::Mesh => b"ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 2147483648\nproperty list uchar int vertex_indices\nend_header\n"
+            .iter()
+            .chain(&[0u8; 36])
+            .copied()
+            .collect(),
         Kind::Json => {
             let mut v: Value = serde_json::from_slice(valid).unwrap();
             if set_sizes(&mut v) {
@@ -375,7 +399,7 @@ fn crc32(bytes: &[u8]) -> u32 {
 }
 
 /// The valid inputs every case starts from: a 16x12 scene, its render as
-/// target and two photographs, masks, an albedo map, a font, a finished
+/// target and two photographs, masks, an albedo map, a mesh, a font, a finished
 /// fit (`run`) and a finished set fit (`setrun`).
 fn fixture() -> tempfile::TempDir {
     let d = tempfile::tempdir().unwrap();
@@ -387,6 +411,13 @@ fn fixture() -> tempfile::TempDir {
     write(&p.join("sa.json"), scene.to_string().as_bytes());
     let map = scenefit::scene::albedo_map::AlbedoMap::uniform(16, 12, 1.0);
     scenefit::scene::albedo_map::write(&p.join("a.exr"), map).unwrap();
+    scene["objects"][0]["material"]
+        .as_object_mut()
+        .unwrap()
+        .remove("albedo_map");
+    scene["objects"][0]["shape"] = json!({"type": "mesh", "file": "m.ply"});
+    write(&p.join("sm.json"), scene.to_string().as_bytes());
+    std::fs::copy(scenes().join("mesh_blob.ply"), p.join("m.ply")).unwrap();
     run_ok(p, &["render", "s.json", "-o", "t.png"]);
     image::GrayImage::from_pixel(16, 12, image::Luma([255]))
         .save(p.join("m.png"))

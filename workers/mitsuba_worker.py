@@ -76,6 +76,8 @@ objects
   sphere  -> ``sphere`` (to_world = translate(center) * scale(radius)).
   plane   -> ``rectangle`` of half-size 1000 m around `point`, normal = `normal`
              (an infinite plane is not available).
+  mesh    -> ``ply`` or ``obj`` (by the file's extension) loading the file
+             scenefit read (its vertex normals when it has them).
   quad    -> ``rectangle`` with to_world columns edge_u/2, edge_v/2,
              normalize(edge_u x edge_v), origin corner + (edge_u+edge_v)/2.
   box     -> ``cube`` mesh whose vertices are set to center + half_size * unit cube.
@@ -260,6 +262,8 @@ def object_plan(o):
         c, eu, ev = sh["corner"], sh["edge_u"], sh["edge_v"]
         n = normalize(cross(eu, ev), where + ": edge_u x edge_v")
         ob["to_world"] = columns_matrix(mul(eu, 0.5), mul(ev, 0.5), n, add(c, mul(add(eu, ev), 0.5)))
+    elif stype == "mesh":
+        ob["file"] = sh["file"]
     else:  # box
         lo, hi = sh["min"], sh["max"]
         ob["center"] = mul(add(lo, hi), 0.5)
@@ -282,7 +286,7 @@ def make_plan(scene):
             "lights": lights, "objects": objects}
     signature = (w, h, camera["type"], desc["indirect"], has_ambient,
                  tuple((L["name"], L["type"]) for L in lights),
-                 tuple((o["name"], o["shape"], o["material"]["kind"]) for o in objects))
+                 tuple((o["name"], o["shape"], o.get("file"), o["material"]["kind"]) for o in objects))
     return signature, plan
 
 
@@ -638,6 +642,10 @@ class MitsubaBackend:
                 d[key] = {"type": "sphere", "to_world": T(O["to_world"]), "bsdf": bsdf}
             elif O["shape"] in ("plane", "quad"):
                 d[key] = {"type": "rectangle", "to_world": T(O["to_world"]), "bsdf": bsdf}
+            elif O["shape"] == "mesh":
+                # Mitsuba's own loaders: vertex normals used when the file has them
+                kind = "obj" if O["file"].lower().endswith(".obj") else "ply"
+                d[key] = {"type": kind, "filename": O["file"], "bsdf": bsdf}
             else:  # box: unit cube, vertices placed through the parameters
                 d[key] = {"type": "cube", "bsdf": bsdf}
         return d
@@ -675,6 +683,8 @@ class MitsubaBackend:
             key = "O%d" % i
             if O["shape"] == "box":
                 v[key + ".vertex_positions"] = ("box", (O["center"], O["half"]))
+            elif O["shape"] == "mesh":
+                pass  # drawn where the file puts it; nothing to move
             else:
                 v[key + ".to_world"] = ("transform", O["to_world"])
             v.update(self.bsdf_values(key, O["material"]))

@@ -18,7 +18,8 @@ worker keeps its own arithmetic):
   exponent: 1/d^power) or ``direction``;
 - ``objects``: ``name``, ``shape`` (``type`` and its fields in world space:
   sphere ``center``, ``radius``; plane ``point``, ``normal``; quad
-  ``corner``, ``edge_u``, ``edge_v``; box ``min``, ``max``) and
+  ``corner``, ``edge_u``, ``edge_v``; box ``min``, ``max``; mesh ``file``,
+  an absolute path to a PLY or OBJ file scenefit has read and checked) and
   ``material``: the project's convention values (docs/renderers.md, "One
   material convention") and its ``kind``: lambertian (diffuse only), phong
   (the built-in tracer's lobes) or principled (transmitting: glass).
@@ -201,7 +202,16 @@ SHAPES = {
     "plane": (("point", "point"), ("normal", "point")),
     "quad": (("corner", "point"), ("edge_u", "point"), ("edge_v", "point")),
     "box": (("min", "point"), ("max", "point")),
+    "mesh": (("file", "path"),),
 }
+
+
+def path(v, where):
+    """A file's path as scenefit writes it (absolute, the file already
+    read and checked by scenefit)."""
+    if not isinstance(v, str) or not v:
+        raise SceneError("%s: expected a file's path, got %r" % (where, v))
+    return v
 
 
 def shape(sh, where):
@@ -212,7 +222,7 @@ def shape(sh, where):
         raise SceneError("%s.type: unknown %r (%s)" % (where, stype, ", ".join(SHAPES)))
     out = {"type": stype}
     for field, kind in SHAPES[stype]:
-        read = vec3 if kind == "point" else num
+        read = {"point": vec3, "number": num, "path": path}[kind]
         out[field] = read(sh.get(field), "%s.%s" % (where, field))
     if stype == "sphere" and out["radius"] <= 0.0:
         raise SceneError("%s.radius: must be > 0" % where)

@@ -24,6 +24,10 @@ pub const MAX_JSON_BYTES: u64 = 256 << 20;
 /// The most a font file may hold: the largest CJK fonts are ~20 MiB.
 pub const MAX_FONT_BYTES: u64 = 64 << 20;
 
+/// The most a mesh file (PLY or OBJ) may hold: ~10 M triangles in
+/// binary PLY, far below what would exhaust memory once parsed.
+pub const MAX_MESH_BYTES: u64 = 256 << 20;
+
 /// The most a text file of a run directory (a trace, a ledger) may hold.
 pub const MAX_TEXT_BYTES: u64 = 64 << 20;
 

@@ -21,7 +21,8 @@
 //!   p with `fade_distance` 1e-8^(1/p); `radius` r > 0 -> a circular,
 //!   oriented `area_light` of diameter 2r (9x9). `directional` -> a
 //!   `parallel` light 1e6 m away along `direction`, colour E*color.
-//! - objects: `sphere`, `plane`, `quad` (`polygon`), `box`.
+//! - objects: `sphere`, `plane`, `quad` (`polygon`), `box`, `mesh`
+//!   (`mesh2`, with `normal_vectors` when the file has vertex normals).
 //! - names: never written (comments say `lights[i]`, `objects[i]`): the
 //!   SDL holds only numbers and fixed keywords, whatever a scene contains.
 //! - refused (a clear error): an object's `transform`, a directional light's `radius`, a material's
@@ -220,6 +221,11 @@ pub fn sdl(scene: &Scene) -> Result<String, String> {
                 vec([lo[0], lo[1], -hi[2]]),
                 vec([hi[0], hi[1], -lo[2]])
             ),
+            Shape::Mesh { ref file } => {
+                let m = crate::scene::mesh::get(std::path::Path::new(file))
+                    .map_err(|e| format!("objects.{}.shape.file: {e}", o.name))?;
+                mesh2(&m)
+            }
         };
         // names are never written: the SDL holds only numbers and keywords
         let _ = writeln!(
@@ -229,6 +235,42 @@ pub fn sdl(scene: &Scene) -> Result<String, String> {
         );
     }
     Ok(s)
+}
+
+/// A mesh as `mesh2` (its numbers only, z mirrored like every point):
+/// smooth triangles when the file gives vertex normals (POV-Ray then takes
+/// the face indices for the normals too), flat ones otherwise.
+fn mesh2(m: &crate::scene::mesh::Mesh) -> String {
+    let mut s = String::with_capacity(64 * (m.positions.len() + m.triangles.len()));
+    let list = |s: &mut String, name: &str, items: &mut dyn Iterator<Item = String>, n: usize| {
+        let _ = write!(s, "\n  {name} {{ {n}");
+        for it in items {
+            let _ = write!(s, ", {it}");
+        }
+        s.push_str(" }");
+    };
+    s.push_str("mesh2 {");
+    let n = m.positions.len();
+    list(
+        &mut s,
+        "vertex_vectors",
+        &mut m.positions.iter().map(|p| vec(pov(*p))),
+        n,
+    );
+    if !m.normals.is_empty() {
+        list(
+            &mut s,
+            "normal_vectors",
+            &mut m.normals.iter().map(|p| vec(pov(*p))),
+            n,
+        );
+    }
+    let faces = &mut m
+        .triangles
+        .iter()
+        .map(|t| format!("<{}, {}, {}>", t[0], t[1], t[2]));
+    list(&mut s, "face_indices", faces, m.triangles.len());
+    s
 }
 
 /// Radiosity for `render.indirect`: gathered light is the mean radiance
@@ -406,6 +448,32 @@ mod tests {
         assert!(
             crate::render::povray::only_version_directive("#version 3.7;\n#include \"x\"").is_err()
         );
+    }
+
+    /// A mesh is written as `mesh2` from the triangles read (z mirrored,
+    /// vertex normals kept, a quad fanned into two triangles), numbers only.
+    #[test]
+    fn a_mesh_is_written_as_mesh2() {
+        let d = tempfile::tempdir().unwrap();
+        let ply = d.path().join("q.ply");
+        let head = "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\nproperty float nx\nproperty float ny\nproperty float nz\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n";
+        let body = "0 0 1 0 0 1\n1 0 1 0 0 1\n1 1 1 0 0 1\n0 1 1 0 0 1\n4 0 1 2 3\n";
+        std::fs::write(&ply, format!("{head}{body}")).unwrap();
+        let mut scene = crate::scene::test_scene::ball(r#""color": [0.5, 0.5, 0.5]"#, "");
+        scene.objects[0].shape = Shape::Mesh {
+            file: ply.display().to_string(),
+        };
+        let out = sdl(&scene).unwrap();
+        assert!(
+            out.contains("mesh2 {\n  vertex_vectors { 4, <0, 0, -1e0>, <1e0, 0, -1e0>"),
+            "{out}"
+        );
+        assert!(out.contains("normal_vectors { 4, <0, 0, -1e0>"), "{out}");
+        assert!(
+            out.contains("face_indices { 2, <0, 1, 2>, <0, 2, 3> }"),
+            "{out}"
+        );
+        assert!(!out.contains("q.ply"), "the path is not written: {out}");
     }
 
     #[test]

@@ -155,6 +155,9 @@ pub fn from_value(value: serde_json::Value, file: &str) -> Result<Scene> {
         if let Some(p) = o.material.albedo_map.as_mut() {
             *p = super::albedo_map::resolve(p, file).display().to_string();
         }
+        if let super::shape::Shape::Mesh { file: p } = &mut o.shape {
+            *p = super::albedo_map::resolve(p, file).display().to_string();
+        }
     }
     validate(&scene, file)?;
     Ok(scene)

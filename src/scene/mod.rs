@@ -9,6 +9,7 @@ pub mod field;
 pub mod limits;
 pub mod load;
 pub mod memory;
+pub mod mesh;
 pub mod nuisance;
 pub mod params;
 pub mod shape;

@@ -34,6 +34,11 @@ pub enum Shape {
         min: Vec3,
         max: Vec3,
     },
+    /// A triangle mesh read from a PLY or OBJ file (`scene/mesh/`): the
+    /// path relative to the scene file, absolute once the scene is read.
+    Mesh {
+        file: String,
+    },
 }
 
 impl Shape {
@@ -44,6 +49,7 @@ impl Shape {
             Shape::Plane { .. } => "plane",
             Shape::Quad { .. } => "quad",
             Shape::Box { .. } => "box",
+            Shape::Mesh { .. } => "mesh",
         }
     }
 
@@ -61,6 +67,8 @@ impl Shape {
                 edge_v,
             } => vec![("corner", corner), ("edge_u", edge_u), ("edge_v", edge_v)],
             Shape::Box { min, max } => vec![("min", min), ("max", max)],
+            // placed by the object's transform, which holds its numbers
+            Shape::Mesh { .. } => vec![],
         }
     }
 
@@ -77,6 +85,7 @@ impl Shape {
                 edge_v,
             } => vec![("corner", corner), ("edge_u", edge_u), ("edge_v", edge_v)],
             Shape::Box { min, max } => vec![("min", min), ("max", max)],
+            Shape::Mesh { .. } => vec![],
         }
     }
 
@@ -90,16 +99,28 @@ impl Shape {
             }
             Ok(())
         };
-        match *self {
-            Shape::Sphere { center, radius } => {
+        match self {
+            Shape::Mesh { file: path } => {
+                // the file itself is read and checked with the scene
+                // (`validate.rs`, `mesh::check`)
+                if path.trim().is_empty() {
+                    return Err(Error::invalid(
+                        file,
+                        key("file"),
+                        "expected a PLY or OBJ file's path",
+                    ));
+                }
+                Ok(())
+            }
+            &Shape::Sphere { center, radius } => {
                 finite("center", center)?;
                 positive(file, &key("radius"), radius)
             }
-            Shape::Plane { point, normal } => {
+            &Shape::Plane { point, normal } => {
                 finite("point", point)?;
                 nonzero3(file, &key("normal"), normal)
             }
-            Shape::Quad {
+            &Shape::Quad {
                 corner,
                 edge_u,
                 edge_v,
@@ -116,7 +137,7 @@ impl Shape {
                 }
                 Ok(())
             }
-            Shape::Box { min, max } => {
+            &Shape::Box { min, max } => {
                 finite("min", min)?;
                 finite("max", max)?;
                 if (0..3).any(|a| min[a] >= max[a]) {
@@ -136,7 +157,9 @@ impl Shape {
     pub fn takes_axis_scales(&self) -> bool {
         match self {
             Shape::Sphere { .. } => false,
-            Shape::Plane { .. } | Shape::Quad { .. } | Shape::Box { .. } => true,
+            Shape::Plane { .. } | Shape::Quad { .. } | Shape::Box { .. } | Shape::Mesh { .. } => {
+                true
+            }
         }
     }
 
@@ -177,6 +200,7 @@ mod tests {
             r#"{"type":"plane","point":[0.0,0.0,0.0],"normal":[0.0,1.0,0.0]}"#,
             r#"{"type":"quad","corner":[0.0,0.0,0.0],"edge_u":[1.0,0.0,0.0],"edge_v":[0.0,0.0,1.0]}"#,
             r#"{"type":"box","min":[0.0,0.0,0.0],"max":[1.0,2.0,3.0]}"#,
+            r#"{"type":"mesh","file":"model.ply"}"#,
         ] {
             let shape = parse(json).unwrap();
             assert_eq!(serde_json::to_string(&shape).unwrap(), json);

@@ -33,6 +33,7 @@ pub fn validate(scene: &Scene, file: &str) -> Result<()> {
     lights(scene, file)?;
     objects(scene, file)?;
     albedo_maps(scene, file)?;
+    meshes(scene, file)?;
     free_list(scene, file)
 }
 
@@ -44,6 +45,18 @@ fn albedo_maps(scene: &Scene, file: &str) -> Result<()> {
         if let Some(p) = &o.material.albedo_map {
             let key = format!("objects[{i}].material.albedo_map");
             super::albedo_map::check(std::path::Path::new(p), size, file, &key)?;
+        }
+    }
+    Ok(())
+}
+
+/// Every mesh shape's file: read once and checked (`mesh.rs`), so that a
+/// bad file is refused before anything renders.
+fn meshes(scene: &Scene, file: &str) -> Result<()> {
+    for (i, o) in scene.objects.iter().enumerate() {
+        if let super::shape::Shape::Mesh { file: p } = &o.shape {
+            let key = format!("objects[{i}].shape.file");
+            super::mesh::check(std::path::Path::new(p), file, &key)?;
         }
     }
     Ok(())

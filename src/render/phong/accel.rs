@@ -12,6 +12,10 @@
 
 use crate::math::V3;
 
+/// Rays start this far off a surface so that they do not hit it again:
+/// hits count in (EPS, t_max).
+pub const EPS: f64 = 1e-7;
+
 /// An axis-aligned box.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Aabb {

@@ -368,7 +368,7 @@ mod tests {
                         (q.normalized(), f64::INFINITY)
                     };
                     let blocked = (0..geo.prims.len()).any(|j| {
-                        geo.owner[j] != grp.object
+                        geo.may_shadow(j, grp.object)
                             && geo.prims[j].hits_before(p + n * 1e-6, w, dist)
                     });
                     if n.dot(w) > 0.0 && !blocked {

@@ -7,10 +7,12 @@
 pub use super::accel::Intersect;
 use super::accel::{Aabb, Accel};
 use super::camera::CameraRays;
+use super::trimesh::{self, Placed};
 use crate::math::V3;
 use crate::scene::transform::Affine;
 use crate::scene::{Scene, Shape};
 use std::ops::Range;
+use std::sync::Arc;
 
 /// An axis-aligned rectangle of image points, in pixels.
 #[derive(Clone, Copy, Debug)]
@@ -46,8 +48,7 @@ impl Rect {
     }
 }
 
-/// Rays start this far off a surface so that they do not hit it again.
-pub const EPS: f64 = 1e-7;
+pub use super::accel::EPS;
 
 #[derive(Clone, Debug)]
 pub enum Prim {
@@ -68,6 +69,16 @@ pub enum Prim {
         n: V3,
         w: V3,
     },
+    /// A triangle mesh under its own BVH (`trimesh.rs`); the one shape
+    /// that is not convex, so it may shadow itself.
+    Mesh(Arc<Placed>),
+}
+
+impl Prim {
+    /// True when no point of the primitive can shadow another of it.
+    pub fn convex(&self) -> bool {
+        !matches!(self, Prim::Mesh(_))
+    }
 }
 
 /// A ray hit: distance along the ray, geometric normal (unit, not yet turned
@@ -138,6 +149,13 @@ impl Geometry {
                     add(quad(lo, ez, ex));
                     add(quad(lo + ey, ez, ex));
                 }
+                // read and checked with the scene; the render refuses a
+                // file gone since (`mod.rs`), so here it is always found
+                Shape::Mesh { ref file } => {
+                    if let Ok(m) = trimesh::get(file) {
+                        add(Prim::Mesh(Arc::new(Placed::new(m, None))))
+                    }
+                }
             }
             if let Some(t) = &obj.transform {
                 let a = Affine::new(t);
@@ -170,12 +188,18 @@ impl Geometry {
         })
     }
 
-    /// True when a primitive of another object than `object` lies on the
-    /// segment from `o` along `d` within (EPS, t_max): our shapes are
-    /// convex, so an object never shadows itself.
+    /// True when a primitive that may shadow `object` lies on the
+    /// segment from `o` along `d` within (EPS, t_max).
     pub fn blocked_by_others(&self, o: V3, d: V3, t_max: f64, object: u32) -> bool {
         self.accel
-            .any(&self.prims, o, d, t_max, |i| self.owner[i] != object)
+            .any(&self.prims, o, d, t_max, |i| self.may_shadow(i, object))
+    }
+
+    /// Whether primitive `i` may shadow a point of `object`: a convex
+    /// shape never shadows itself, a mesh may.
+    #[inline]
+    pub fn may_shadow(&self, i: usize, object: u32) -> bool {
+        self.owner[i] != object || !self.prims[i].convex()
     }
 
     /// For each primitive, the pixel rectangle its image lies in, when one
@@ -189,7 +213,9 @@ impl Geometry {
             .map(|prim| {
                 let corners: Vec<V3> = match *prim {
                     Prim::Quad { o, u, v, .. } => vec![o, o + u, o + v, o + u + v],
-                    Prim::Sphere { .. } | Prim::Plane { .. } => prim.bounds()?.corners().to_vec(),
+                    Prim::Sphere { .. } | Prim::Plane { .. } | Prim::Mesh(_) => {
+                        prim.bounds()?.corners().to_vec()
+                    }
                 };
                 let mut rect = Rect::EMPTY;
                 for k in corners {
@@ -297,6 +323,7 @@ fn placed(p: &Prim, a: &Affine) -> Prim {
             n: a.normal(n).normalized(),
         },
         Prim::Quad { o, u, v, .. } => quad(a.point(o), a.vector(u), a.vector(v)),
+        Prim::Mesh(ref m) => Prim::Mesh(Arc::new(Placed::new(m.mesh.clone(), Some(a)))),
     }
 }
 
@@ -360,6 +387,7 @@ impl Intersect for Prim {
                 let b = w.dot(u.cross(q));
                 ((0.0..=1.0).contains(&a) && (0.0..=1.0).contains(&b)).then_some((t, n))
             }
+            Prim::Mesh(ref m) => m.hit(o, d, t_max),
         }
     }
 
@@ -369,6 +397,7 @@ impl Intersect for Prim {
             Prim::Sphere { c, r2 } => sphere_roots(o, d, c, r2)
                 .is_some_and(|(t0, t1)| (t0 > EPS && t0 < t_max) || (t1 > EPS && t1 < t_max)),
             Prim::Plane { .. } | Prim::Quad { .. } => self.hit(o, d, t_max).is_some(),
+            Prim::Mesh(ref m) => m.any(o, d, t_max),
         }
     }
 
@@ -390,13 +419,14 @@ impl Intersect for Prim {
                 Some(b)
             }
             Prim::Plane { .. } => None,
+            Prim::Mesh(ref m) => Some(m.bounds),
         }
     }
 
     fn may_block(&self, p: V3, lo: V3, hi: V3) -> bool {
         match *self {
             // The segments lie in the bounding box of p and [lo, hi].
-            Prim::Sphere { .. } => self
+            Prim::Sphere { .. } | Prim::Mesh(_) => self
                 .bounds()
                 .is_none_or(|b| b.overlaps(&Aabb::hull(p, lo, hi))),
             Prim::Plane { p: q, n } | Prim::Quad { o: q, n, .. } => {
@@ -478,6 +508,67 @@ mod tests {
                 }
             }
             assert!(hits > 5, "{shape}: {hits} hits");
+        }
+    }
+
+    /// A box's twelve triangles as an ASCII PLY file in `dir`.
+    fn box_ply(dir: &std::path::Path, lo: [f64; 3], hi: [f64; 3]) -> String {
+        let mut ply = "ply\nformat ascii 1.0\nelement vertex 8\nproperty double x\nproperty double y\nproperty double z\nelement face 6\nproperty list uchar int vertex_indices\nend_header\n".to_string();
+        for k in 0..8 {
+            let c = |a: usize| if k >> a & 1 == 0 { lo[a] } else { hi[a] };
+            ply += &format!("{} {} {}\n", c(0), c(1), c(2));
+        }
+        // the six faces as quads (fanned on reading)
+        for f in [
+            "0 1 3 2", "4 6 7 5", "0 4 5 1", "2 3 7 6", "0 2 6 4", "1 5 7 3",
+        ] {
+            ply += &format!("4 {f}\n");
+        }
+        let p = dir.join("box.ply");
+        std::fs::write(&p, ply).unwrap();
+        p.display().to_string()
+    }
+
+    /// A box written as a mesh is hit where the box shape is, at the same
+    /// distance with the same normal, as it is and placed by a transform
+    /// (the mesh's rays carried into its frame, its normals out).
+    #[test]
+    fn a_mesh_box_is_hit_where_the_box_is() {
+        let d = tempfile::tempdir().unwrap();
+        let file = box_ply(d.path(), [-0.5, -0.5, -0.5], [0.5, 0.5, 0.5]);
+        let mesh = format!(r#"{{"type": "mesh", "file": {file:?}}}"#);
+        let cube = r#"{"type": "box", "min": [-0.5, -0.5, -0.5], "max": [0.5, 0.5, 0.5]}"#;
+        for transform in [
+            "",
+            r#"{"scale": [2, 1, 0.5], "rotate_deg": [10, 35, -20], "translate": [0, 0.5, 0]}"#,
+        ] {
+            let (a, b) = (one(cube, transform), one(&mesh, transform));
+            assert!(!b.prims[0].convex());
+            let mut hits = 0;
+            for i in 0..400 {
+                let (x, y) = (
+                    (i % 20) as f64 * 0.1037 - 1.01,
+                    (i / 20) as f64 * 0.0971 - 0.49,
+                );
+                let o = V3::new(0.313, 1.517, 5.0);
+                let d = (V3::new(x, y, 0.0) - o).normalized();
+                let (ha, hb) = (a.intersect(o, d, 1e9), b.intersect(o, d, 1e9));
+                assert_eq!(ha.is_some(), hb.is_some(), "{transform}: ray {i}");
+                if let (Some(ha), Some(hb)) = (ha, hb) {
+                    assert!(
+                        (ha.t - hb.t).abs() < 1e-9,
+                        "{transform}: {} vs {}",
+                        ha.t,
+                        hb.t
+                    );
+                    assert!((ha.n.dot(hb.n).abs() - 1.0).abs() < 1e-9, "{transform}");
+                    // from the far side of the hit, back through the mesh: it shadows itself
+                    let p = o + d * (hb.t + 1e-3);
+                    assert!(b.blocked_by_others(p, -d, 1.0, 0), "{transform}: ray {i}");
+                    hits += 1;
+                }
+            }
+            assert!(hits > 50, "{transform}: {hits} hits");
         }
     }
 }

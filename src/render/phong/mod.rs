@@ -17,12 +17,14 @@
 
 mod accel;
 mod bounce;
+mod bvh;
 mod camera;
 mod effects;
 mod geometry;
 mod packed;
 mod paths;
 mod shade;
+mod trimesh;
 
 use super::{Image, RenderFailure, RenderResult, RenderSession, Renderer};
 use crate::error::{Error, Result};
@@ -104,6 +106,12 @@ impl PhongSession {
         let (w, h) = (scene.image.width, scene.image.height);
         let mut buf = vec![0u8; (w * h * 3) as usize];
         let maps = shade::albedo_maps(scene)?;
+        // meshes were read with the scene; a file unreadable since fails here
+        for o in &scene.objects {
+            if let crate::scene::Shape::Mesh { file } = &o.shape {
+                trimesh::get(file).map_err(|e| RenderFailure::new(e.to_string()))?;
+            }
+        }
         match &self.cached {
             Some(p) => shade::shade(&p.paths, &p.packed, scene, &maps, &mut buf),
             None => {

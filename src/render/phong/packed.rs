@@ -181,15 +181,15 @@ impl Packed {
         })
     }
 
-    /// For each group, the primitives of `geo` owned by other objects. Our
-    /// shapes are convex, so a hit is never shadowed by its own object.
+    /// For each group, the primitives of `geo` that may shadow its object:
+    /// those of other objects, and its own if it is a mesh (not convex).
     pub fn others(&self, geo: &super::geometry::Geometry) -> &[Vec<u32>] {
         self.others.get_or_init(|| {
             self.groups
                 .iter()
                 .map(|g| {
                     (0..geo.prims.len() as u32)
-                        .filter(|&i| geo.owner[i as usize] != g.object)
+                        .filter(|&i| geo.may_shadow(i as usize, g.object))
                         .collect()
                 })
                 .collect()

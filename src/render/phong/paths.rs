@@ -297,7 +297,7 @@ impl Tracer<'_> {
     fn classify(&mut self, p: V3, n: V3, object: u32, l: usize) -> Shadow {
         let light = &self.scene.lights[l];
         let g = self.geometry;
-        let others = |i: &usize| g.owner[*i] != object; // our shapes are convex: no self-shadowing
+        let others = |i: &usize| g.may_shadow(*i, object);
         let fixed = match (light.kind, self.var.lights[l]) {
             (LightKind::Point, LightRange::Fixed) => {
                 let to = V3::from(light.position.unwrap_or_default()) - p;

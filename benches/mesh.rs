@@ -1,0 +1,185 @@
+//! Renders per second of the built-in tracer on meshes: an icosphere of
+//! 1,280 and of 81,920 triangles (vertex normals, a floor, one point light
+//! with shadows, 128x96), against the analytic sphere it approximates, in a
+//! generation of 80 candidates with (a) the light free (position and
+//! intensity; camera hits traced once, shadow rays per candidate) and (b)
+//! the floor free (geometry moves: every camera and shadow ray traced per
+//! candidate). Then, timed once: reading and building the BVH of a
+//! 1,310,720-triangle mesh. `cargo bench --bench mesh`; figures in
+//! docs/benchmarks.md.
+
+use criterion::{criterion_group, criterion_main, Criterion, Throughput};
+use rand::{Rng, SeedableRng};
+use scenefit::render::{from_spec, RenderSession};
+use scenefit::scene::{parse, ParamSpace, Scene};
+use std::path::Path;
+
+/// An icosahedron subdivided `level` times onto the sphere of `radius`
+/// about `c`, as binary PLY with vertex normals (20 * 4^level triangles).
+fn icosphere(path: &Path, level: u32, c: [f32; 3], radius: f32) {
+    let t = (1.0 + 5f32.sqrt()) / 2.0;
+    let unit = |v: [f32; 3]| {
+        let n = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+        v.map(|x| x / n)
+    };
+    let mut verts: Vec<[f32; 3]> = [
+        [-1.0, t, 0.0],
+        [1.0, t, 0.0],
+        [-1.0, -t, 0.0],
+        [1.0, -t, 0.0],
+        [0.0, -1.0, t],
+        [0.0, 1.0, t],
+        [0.0, -1.0, -t],
+        [0.0, 1.0, -t],
+        [t, 0.0, -1.0],
+        [t, 0.0, 1.0],
+        [-t, 0.0, -1.0],
+        [-t, 0.0, 1.0],
+    ]
+    .map(unit)
+    .to_vec();
+    let mut faces: Vec<[u32; 3]> = vec![
+        [0, 11, 5],
+        [0, 5, 1],
+        [0, 1, 7],
+        [0, 7, 10],
+        [0, 10, 11],
+        [1, 5, 9],
+        [5, 11, 4],
+        [11, 10, 2],
+        [10, 7, 6],
+        [7, 1, 8],
+        [3, 9, 4],
+        [3, 4, 2],
+        [3, 2, 6],
+        [3, 6, 8],
+        [3, 8, 9],
+        [4, 9, 5],
+        [2, 4, 11],
+        [6, 2, 10],
+        [8, 6, 7],
+        [9, 8, 1],
+    ];
+    for _ in 0..level {
+        let mut mid = std::collections::HashMap::new();
+        let mut next = Vec::with_capacity(faces.len() * 4);
+        for f in &faces {
+            let mut m = |a: u32, b: u32| {
+                *mid.entry((a.min(b), a.max(b))).or_insert_with(|| {
+                    let (p, q) = (verts[a as usize], verts[b as usize]);
+                    verts.push(unit([p[0] + q[0], p[1] + q[1], p[2] + q[2]]));
+                    verts.len() as u32 - 1
+                })
+            };
+            let (ab, bc, ca) = (m(f[0], f[1]), m(f[1], f[2]), m(f[2], f[0]));
+            next.extend([[f[0], ab, ca], [f[1], bc, ab], [f[2], ca, bc], [ab, bc, ca]]);
+        }
+        faces = next;
+    }
+    let mut out = format!(
+        "ply\nformat binary_little_endian 1.0\nelement vertex {}\nproperty float x\nproperty float y\nproperty float z\nproperty float nx\nproperty float ny\nproperty float nz\nelement face {}\nproperty list uchar int vertex_indices\nend_header\n",
+        verts.len(),
+        faces.len()
+    )
+    .into_bytes();
+    for v in &verts {
+        for k in 0..3 {
+            out.extend((c[k] + radius * v[k]).to_le_bytes());
+        }
+        for x in v {
+            out.extend(x.to_le_bytes());
+        }
+    }
+    for f in &faces {
+        out.push(3);
+        for i in f {
+            out.extend((*i as i32).to_le_bytes());
+        }
+    }
+    std::fs::write(path, out).unwrap();
+}
+
+/// The bench scene with `shape` as the object and `free` free.
+fn scene(shape: serde_json::Value, free: serde_json::Value) -> Scene {
+    let v = serde_json::json!({
+        "format": "scenefit-scene/1",
+        "image": {"width": 128, "height": 96},
+        "camera": {"type": "perspective", "position": [0, 1.5, 5], "look_at": [0, 0.5, 0], "up": [0, 1, 0], "fov_y_deg": 40},
+        "render": {"indirect": false},
+        "lights": [{"name": "key", "type": "point", "position": [1, 3, 2], "color": [1, 1, 1], "intensity": 10.0}],
+        "objects": [
+            {"name": "ball", "shape": shape, "material": {"color": [0.8, 0.7, 0.1], "specular": 0.3, "shininess": 30}},
+            {"name": "floor", "shape": {"type": "plane", "point": [0, 0, 0], "normal": [0, 1, 0]},
+             "material": {"color": [0.6, 0.6, 0.6]}}
+        ],
+        "free": free
+    });
+    parse(&v.to_string(), "bench scene", &[]).expect("bench scene is valid")
+}
+
+fn generation(base: &Scene) -> (Box<dyn RenderSession>, Vec<Scene>) {
+    let space = ParamSpace::from_scene(base);
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
+    let scenes: Vec<Scene> = (0..80)
+        .map(|_| {
+            let u: Vec<f64> = (0..space.dim()).map(|_| rng.gen()).collect();
+            space.scene_at(base, &u)
+        })
+        .collect();
+    let jobs = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let session = from_spec("phong")
+        .unwrap()
+        .session(base, &space, jobs)
+        .unwrap();
+    (session, scenes)
+}
+
+fn bench(c: &mut Criterion) {
+    let dir = tempfile::tempdir().unwrap();
+    let mut shapes = vec![(
+        "sphere".to_string(),
+        serde_json::json!({"type": "sphere", "center": [0, 0.5, 0], "radius": 0.5}),
+    )];
+    for level in [3, 6] {
+        let p = dir.path().join(format!("ico{level}.ply"));
+        icosphere(&p, level, [0.0, 0.5, 0.0], 0.5);
+        let faces = 20 * 4u32.pow(level);
+        shapes.push((
+            format!("mesh_{faces}"),
+            serde_json::json!({"type": "mesh", "file": p}),
+        ));
+    }
+    let light = serde_json::json!([
+        {"param": "lights.key.position", "min": [-3, 0.5, -3], "max": [3, 5, 5]},
+        {"param": "lights.key.intensity", "min": 1, "max": 50}
+    ]);
+    let floor = serde_json::json!([{"param": "objects.floor.shape.point", "min": [0, -0.1, 0], "max": [0, 0, 0]}]);
+    let mut group = c.benchmark_group("phong_mesh_generation_of_80");
+    group.throughput(Throughput::Elements(80));
+    group.sample_size(10);
+    for (what, free) in [("light_free", &light), ("geometry_moves", &floor)] {
+        for (name, shape) in &shapes {
+            let (mut session, scenes) = generation(&scene(shape.clone(), free.clone()));
+            group.bench_function(format!("{what}/{name}"), |b| {
+                b.iter(|| session.render_batch(&scenes, 0))
+            });
+        }
+    }
+    group.finish();
+    // reading, checking and building the BVH of 1.3 M triangles, once
+    let p = dir.path().join("ico8.ply");
+    icosphere(&p, 8, [0.0, 0.5, 0.0], 0.5);
+    let big = scene(
+        serde_json::json!({"type": "mesh", "file": p}),
+        serde_json::json!([]),
+    );
+    let t = std::time::Instant::now();
+    scenefit::render::render_one(from_spec("phong").unwrap().as_ref(), &big, 0).unwrap();
+    eprintln!(
+        "1310720 triangles: read, BVH built and one 128x96 render in {:.2?}",
+        t.elapsed()
+    );
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);

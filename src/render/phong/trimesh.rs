@@ -1,0 +1,252 @@
+//! A mesh shape as the tracer sees it: its triangles in the file's frame
+//! under a BVH (`bvh.rs`), built once per process and mesh file and shared
+//! by every candidate, and a placement (the object's transform) that
+//! carries rays into that frame and normals out of it — so that a free
+//! pose costs no rebuild.
+
+use super::accel::{Aabb, EPS};
+use super::bvh::Bvh;
+use crate::math::V3;
+use crate::scene::mesh::{self, Mesh};
+use crate::scene::transform::Affine;
+use std::collections::HashMap;
+use std::path::Path;
+use std::sync::{Arc, Mutex, OnceLock};
+
+/// A triangle as a corner and two edges (Möller–Trumbore's form).
+#[derive(Clone, Copy, Debug)]
+struct Tri {
+    v0: V3,
+    e1: V3,
+    e2: V3,
+}
+
+impl Tri {
+    /// Distance and barycentric (u, v) of the hit within (EPS, t_max).
+    #[inline(always)]
+    fn hit(&self, o: V3, d: V3, t_max: f64) -> Option<(f64, f64, f64)> {
+        let p = d.cross(self.e2);
+        let det = self.e1.dot(p);
+        if det == 0.0 {
+            return None;
+        }
+        let inv = 1.0 / det;
+        let s = o - self.v0;
+        let u = s.dot(p) * inv;
+        if !(0.0..=1.0).contains(&u) {
+            return None;
+        }
+        let q = s.cross(self.e1);
+        let v = d.dot(q) * inv;
+        if v < 0.0 || u + v > 1.0 {
+            return None;
+        }
+        let t = self.e2.dot(q) * inv;
+        (t > EPS && t < t_max).then_some((t, u, v))
+    }
+}
+
+/// A mesh's triangles, in BVH order, with their vertex normals if any.
+#[derive(Debug)]
+pub struct TriMesh {
+    tris: Vec<Tri>,
+    normals: Vec<[V3; 3]>,
+    bvh: Bvh,
+    pub bounds: Aabb,
+}
+
+impl TriMesh {
+    pub fn new(m: &Mesh) -> TriMesh {
+        let p = |i: u32| V3::from(m.positions[i as usize]);
+        let boxes: Vec<Aabb> = m
+            .triangles
+            .iter()
+            .map(|t| {
+                let b = Aabb {
+                    lo: p(t[0]),
+                    hi: p(t[0]),
+                };
+                let b = Aabb::hull(p(t[1]), b.lo, b.hi);
+                Aabb::hull(p(t[2]), b.lo, b.hi)
+            })
+            .collect();
+        let bvh = Bvh::build(&boxes);
+        let tri = |t: &[u32; 3]| Tri {
+            v0: p(t[0]),
+            e1: p(t[1]) - p(t[0]),
+            e2: p(t[2]) - p(t[0]),
+        };
+        let sorted = bvh.order.iter().map(|&i| &m.triangles[i as usize]);
+        let tris = sorted.clone().map(tri).collect();
+        let normals = if m.normals.is_empty() {
+            Vec::new()
+        } else {
+            sorted
+                .map(|t| t.map(|i| V3::from(m.normals[i as usize])))
+                .collect()
+        };
+        let (lo, hi) = m.bounds();
+        TriMesh {
+            tris,
+            normals,
+            bvh,
+            bounds: Aabb {
+                lo: V3::from(lo),
+                hi: V3::from(hi),
+            },
+        }
+    }
+
+    /// The nearest hit: distance and the shading normal (not unit): the
+    /// vertex normals interpolated, or the face normal; on the side of the
+    /// face the ray meets, so that the tracer's front and back agree with
+    /// the geometry.
+    #[inline]
+    pub fn hit(&self, o: V3, d: V3, t_max: f64) -> Option<(f64, V3)> {
+        let mut uv = (0.0, 0.0);
+        let (k, t) = self.bvh.nearest(o, d, t_max, |k, tb| {
+            let (t, u, v) = self.tris[k].hit(o, d, tb)?;
+            uv = (u, v);
+            Some(t)
+        })?;
+        // uv is the last accepted hit's, which is the nearest
+        let tri = &self.tris[k];
+        let ng = tri.e1.cross(tri.e2);
+        let Some(n) = self.normals.get(k) else {
+            return Some((t, ng));
+        };
+        let (u, v) = uv;
+        let ns = n[0] * (1.0 - u - v) + n[1] * u + n[2] * v;
+        let ns = if ns.dot(ng) < 0.0 { -ns } else { ns };
+        // a shading normal turned past the ray (or zero) would flip the
+        // side the tracer shades: keep the face's there
+        let same_side = (ns.dot(d) < 0.0) == (ng.dot(d) < 0.0) && ns.dot(ns) > 0.0;
+        Some((t, if same_side { ns } else { ng }))
+    }
+
+    /// True when any triangle is hit within (EPS, t_max).
+    #[inline]
+    pub fn any(&self, o: V3, d: V3, t_max: f64) -> bool {
+        self.bvh
+            .any(o, d, t_max, |k| self.tris[k].hit(o, d, t_max).is_some())
+    }
+}
+
+type Cache = Mutex<HashMap<String, Arc<TriMesh>>>;
+
+/// The traced form of the mesh file `path`, built once per process.
+pub fn get(path: &str) -> crate::error::Result<Arc<TriMesh>> {
+    static CACHE: OnceLock<Cache> = OnceLock::new();
+    let cache = CACHE.get_or_init(Default::default);
+    if let Some(t) = cache.lock().expect("mesh cache").get(path) {
+        return Ok(t.clone());
+    }
+    let t = Arc::new(TriMesh::new(&*mesh::get(Path::new(path))?));
+    cache
+        .lock()
+        .expect("mesh cache")
+        .insert(path.to_string(), t.clone());
+    Ok(t)
+}
+
+/// A mesh placed in the scene: world rays go into the mesh's frame by
+/// the inverse of the object's transform (distances along them kept, as
+/// the direction is not renormalised), normals come out by the transform.
+#[derive(Debug)]
+pub struct Placed {
+    pub mesh: Arc<TriMesh>,
+    place: Place,
+    pub bounds: Aabb,
+}
+
+#[derive(Debug)]
+enum Place {
+    AsRead,
+    Moved(Box<(Affine, Inverse)>),
+    /// A transform that flattens the mesh (a zero scale): nothing to hit.
+    Flat,
+}
+
+/// x -> m (x - t): the inverse of an affine map.
+#[derive(Clone, Copy, Debug)]
+struct Inverse {
+    m: [V3; 3],
+    t: V3,
+}
+
+impl Inverse {
+    fn of(a: &Affine) -> Option<Inverse> {
+        let axes = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+        let c = axes.map(|e| a.vector(V3::from(e)));
+        // rows of the inverse: the cross products of the columns over the determinant
+        let det = c[0].dot(c[1].cross(c[2]));
+        if det == 0.0 || !det.is_finite() {
+            return None;
+        }
+        let m = [
+            c[1].cross(c[2]) / det,
+            c[2].cross(c[0]) / det,
+            c[0].cross(c[1]) / det,
+        ];
+        Some(Inverse {
+            m,
+            t: a.point(V3::new(0.0, 0.0, 0.0)),
+        })
+    }
+
+    fn vector(&self, v: V3) -> V3 {
+        V3::new(self.m[0].dot(v), self.m[1].dot(v), self.m[2].dot(v))
+    }
+}
+
+impl Placed {
+    pub fn new(mesh: Arc<TriMesh>, a: Option<&Affine>) -> Placed {
+        let place = match a {
+            None => Place::AsRead,
+            Some(a) => Inverse::of(a).map_or(Place::Flat, |inv| Place::Moved(Box::new((*a, inv)))),
+        };
+        let bounds = match &place {
+            Place::AsRead | Place::Flat => mesh.bounds,
+            Place::Moved(m) => {
+                let a = &m.0;
+                let c = mesh.bounds.corners().map(|k| a.point(k));
+                c.iter().fold(Aabb { lo: c[0], hi: c[0] }, |b, &k| {
+                    Aabb::hull(k, b.lo, b.hi)
+                })
+            }
+        };
+        Placed {
+            mesh,
+            place,
+            bounds,
+        }
+    }
+
+    /// The ray in the mesh's frame; `None` when there is nothing to hit.
+    #[inline]
+    fn local(&self, o: V3, d: V3) -> Option<(V3, V3)> {
+        match &self.place {
+            Place::AsRead => Some((o, d)),
+            Place::Moved(m) => Some((m.1.vector(o - m.1.t), m.1.vector(d))),
+            Place::Flat => None,
+        }
+    }
+
+    /// Distance and unit normal of the nearest hit.
+    #[inline]
+    pub fn hit(&self, o: V3, d: V3, t_max: f64) -> Option<(f64, V3)> {
+        let (ol, dl) = self.local(o, d)?;
+        let (t, n) = self.mesh.hit(ol, dl, t_max)?;
+        let n = match &self.place {
+            Place::Moved(m) => m.0.normal(n),
+            _ => n,
+        };
+        Some((t, n.normalized()))
+    }
+
+    #[inline]
+    pub fn any(&self, o: V3, d: V3, t_max: f64) -> bool {
+        self.local(o, d)
+            .is_some_and(|(ol, dl)| self.mesh.any(ol, dl, t_max))
+    }
+}
