@@ -62,6 +62,10 @@ Shapes
     rotated onto `normal`.
   quad: its own 4-vertex mesh corner, corner+u, corner+u+v, corner+v.
   box: a shared flat-shaded unit cube [0,1]^3, location = min, scale = size.
+  transform (an object's placement, scene_common.transform): every object
+    is the child of an empty whose world matrix is that transform in
+    Blender's frame (identity when absent), so the shape's own placement
+    above is kept as it is.
   Cycles shades both sides of every face.
 Materials (per object, linked to the object's material slot)
   specular = specular2 = reflection = transmission = 0 ("lambertian"):
@@ -463,10 +467,13 @@ class Worker:
             ob = bpy.data.objects.new(PREFIX + "obj_" + name, me)
             ob.rotation_mode = "QUATERNION"
             coll.objects.link(ob)
+            place = bpy.data.objects.new(PREFIX + "place_" + name, None)
+            coll.objects.link(place)
+            ob.parent = place
             mat, nodes = self._make_material(PREFIX + "mat_" + name, mkind)
             ob.material_slots[0].link = "OBJECT"
             ob.material_slots[0].material = mat
-            self.objects.append({"obj": ob, "shape": stype, "mesh": own_mesh,
+            self.objects.append({"obj": ob, "place": place, "shape": stype, "mesh": own_mesh,
                                  "kind": mkind, "nodes": nodes, "mat": mat})
         self.structure = structure
 
@@ -603,6 +610,7 @@ class Worker:
         for (lo, fnode), L in zip(self.lights, desc["lights"]):
             self._apply_light(lo, fnode, L)
         for ent, o in zip(self.objects, desc["objects"]):
+            self._apply_place(ent["place"], o["transform"])
             self._apply_shape(ent, o["shape"], "object '%s'" % o["name"])
             self._apply_material(ent, o["material"], desc["lights"])
 
@@ -647,6 +655,16 @@ class Worker:
             _set(ld, "energy", L["intensity"])
             # the sun's angle is its angular diameter
             _set(ld, "angle", 2.0 * L["radius"])
+
+    def _apply_place(self, place, t):
+        """The object's transform in Blender's frame: B t B^-1 with
+        B (x, y, z) -> (x, -z, y)."""
+        m = Matrix.Identity(4)
+        if t is not None:
+            b = Matrix(((1, 0, 0, 0), (0, 0, -1, 0), (0, 1, 0, 0), (0, 0, 0, 1)))
+            m = b @ Matrix(t) @ b.inverted()
+        if place.matrix_world != m:
+            place.matrix_world = m
 
     def _apply_shape(self, ent, sh, where):
         ob = ent["obj"]

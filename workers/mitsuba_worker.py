@@ -79,6 +79,8 @@ objects
   quad    -> ``rectangle`` with to_world columns edge_u/2, edge_v/2,
              normalize(edge_u x edge_v), origin corner + (edge_u+edge_v)/2.
   box     -> ``cube`` mesh whose vertices are set to center + half_size * unit cube.
+  transform (an object's placement, scene_common.transform): its matrix times
+             the shape's to_world; for a box, applied to each vertex.
 materials (d = diffuse, c = color, ks = specular, n = shininess, kr = reflection,
   kt = transmission)
   ks = ks2 = kr = kt = 0 -> ``twosided`` ``diffuse`` with reflectance d*c
@@ -123,8 +125,8 @@ import sys
 import time
 
 import jsonlines
-from scene_common import (SceneError, add, cross, describe, mul, norm, normalize,
-                          roughness, sub)
+from scene_common import (SceneError, add, apply_point, cross, describe, matmul4, mul, norm,
+                          normalize, roughness, sub)
 
 LLVM19 = "/usr/lib/x86_64-linux-gnu/libLLVM-19.so"
 PLANE_HALF_SIZE = 1000.0
@@ -264,6 +266,10 @@ def object_plan(o):
         lo, hi = sh["min"], sh["max"]
         ob["center"] = mul(add(lo, hi), 0.5)
         ob["half"] = mul(sub(hi, lo), 0.5)
+    # the object's transform: after the shape's own placement
+    ob["transform"] = o["transform"]
+    if o["transform"] is not None and "to_world" in ob:
+        ob["to_world"] = matmul4(o["transform"], ob["to_world"])
     return ob
 
 
@@ -674,7 +680,7 @@ class MitsubaBackend:
         for i, O in enumerate(plan["objects"]):
             key = "O%d" % i
             if O["shape"] == "box":
-                v[key + ".vertex_positions"] = ("box", (O["center"], O["half"]))
+                v[key + ".vertex_positions"] = ("box", (O["center"], O["half"], O["transform"]))
             else:
                 v[key + ".to_world"] = ("transform", O["to_world"])
             v.update(self.bsdf_values(key, O["material"]))
@@ -694,9 +700,11 @@ class MitsubaBackend:
         if kind == "transform":
             return type(self.params[key])(mi.ScalarTransform4f([list(r) for r in value]))
         if kind == "box":
-            center, half = value
+            center, half, place = value
             unit = self.unit_cubes[key]
             pos = [center[k % 3] + half[k % 3] * unit[k] for k in range(len(unit))]
+            if place is not None:
+                pos = [x for k in range(0, len(pos), 3) for x in apply_point(place, pos[k:k + 3])]
             return type(self.params[key])(pos)
         raise AssertionError(kind)
 

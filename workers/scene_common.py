@@ -225,6 +225,49 @@ def shape(sh, where):
     return out
 
 
+def rotation_xyz(deg):
+    """Rows of Rz Ry Rx for angles in degrees: about world x first."""
+    cx, cy, cz = (math.cos(math.radians(a)) for a in deg)
+    sx, sy, sz = (math.sin(math.radians(a)) for a in deg)
+    rx = ((1, 0, 0), (0, cx, -sx), (0, sx, cx))
+    ry = ((cy, 0, sy), (0, 1, 0), (-sy, 0, cy))
+    rz = ((cz, -sz, 0), (sz, cz, 0), (0, 0, 1))
+    return matmul3(rz, matmul3(ry, rx))
+
+
+def matmul3(a, b):
+    return tuple(tuple(sum(a[i][k] * b[k][j] for k in range(3)) for j in range(3)) for i in range(3))
+
+
+def transform(t, where):
+    """An object's `transform` as a 4x4 row-major matrix, or None."""
+    if t is None:
+        return None
+    if not isinstance(t, dict):
+        raise SceneError("%s: expected an object" % where)
+    unknown = set(t) - {"translate", "rotate_deg", "scale"}
+    if unknown:
+        raise SceneError("%s: unknown key %r" % (where, sorted(unknown)[0]))
+    move = vec3(t.get("translate", [0, 0, 0]), where + ".translate")
+    turn = vec3(t.get("rotate_deg", [0, 0, 0]), where + ".rotate_deg")
+    sc = t.get("scale", 1.0)
+    sc = vec3(sc, where + ".scale") if isinstance(sc, list) else (num(sc, where + ".scale"),) * 3
+    if any(k <= 0.0 for k in sc):
+        raise SceneError("%s.scale: must be > 0, got %r" % (where, t.get("scale")))
+    r = rotation_xyz(turn)
+    return tuple(tuple(r[i][j] * sc[j] for j in range(3)) + (move[i],) for i in range(3)) + ((0.0, 0.0, 0.0, 1.0),)
+
+
+def matmul4(a, b):
+    """a b for 4x4 row-major matrices (b applied first)."""
+    return tuple(tuple(sum(a[i][k] * b[k][j] for k in range(4)) for j in range(4)) for i in range(4))
+
+
+def apply_point(m, p):
+    """A 4x4 row-major affine matrix applied to a point."""
+    return tuple(m[i][0] * p[0] + m[i][1] * p[1] + m[i][2] * p[2] + m[i][3] for i in range(3))
+
+
 def camera(cam, where):
     out = {"type": cam.get("type", "perspective"),
            "position": vec3(cam.get("position"), where + ".position"),
@@ -262,7 +305,8 @@ def describe(scene):
     for name, where, o in named_entries(scene, "objects", "object"):
         objects.append({"name": name,
                         "shape": shape(obj(o, "shape", where), where + ".shape"),
-                        "material": material(o.get("material"), where + ".material")})
+                        "material": material(o.get("material"), where + ".material"),
+                        "transform": transform(o.get("transform"), where + ".transform")})
     return {
         "width": w, "height": h, "indirect": indirect,
         "samples": count(render, "samples", "render", 16),

@@ -5,8 +5,7 @@
 //! Blinn-Phong lobes, `fresnel`, `specular2`) and any `falloff_power`
 //! (docs/renderers.md, "One material convention").
 //!
-//! Refused: an object's `transform` (the workers do not place shapes
-//! yet), a Mitsuba area light (`radius` > 0: a shape with an area
+//! Refused: a Mitsuba area light (`radius` > 0: a shape with an area
 //! emitter) with a falloff other than 1/d^2, and `fresnel` or `specular2` on a
 //! transmitting material (glass is drawn by the principled BSDF, with its
 //! own Fresnel term and one lobe), `albedo_map` (a map in the image's
@@ -48,12 +47,6 @@ fn refusals(scene: &Scene, mitsuba: bool) -> Vec<Refusal> {
         }
     }
     for o in &scene.objects {
-        if o.transform.is_some() {
-            refuse(
-                format!("objects.{}.transform", o.name),
-                "a placed object is drawn by phong only so far; use phong, or write the shape where it is",
-            );
-        }
         let m = &o.material;
         if m.albedo_map.is_some() {
             refuse(
@@ -103,21 +96,6 @@ mod tests {
                 refused[0].field.ends_with("material.diffuse_f90"),
                 "{refused:?}"
             );
-        }
-    }
-
-    #[test]
-    fn a_transform_is_refused_by_every_other_backend_naming_the_field() {
-        let mut scene = crate::scene::test_scene::ball(r#""color": [0.5, 0.5, 0.5]"#, "");
-        let pov = crate::render::pov_sdl::refusals;
-        assert!(blender(&scene).is_empty() && mitsuba(&scene).is_empty() && pov(&scene).is_empty());
-        scene.objects[0].transform = Some(crate::scene::Transform {
-            translate: Some([0.0, 0.1, 0.0]),
-            ..Default::default()
-        });
-        for refused in [blender(&scene), mitsuba(&scene), pov(&scene)] {
-            assert_eq!(refused.len(), 1, "{refused:?}");
-            assert_eq!(refused[0].field, "objects.ball.transform", "{refused:?}");
         }
     }
 }

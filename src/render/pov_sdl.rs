@@ -21,10 +21,12 @@
 //!   p with `fade_distance` 1e-8^(1/p); `radius` r > 0 -> a circular,
 //!   oriented `area_light` of diameter 2r (9x9). `directional` -> a
 //!   `parallel` light 1e6 m away along `direction`, colour E*color.
-//! - objects: `sphere`, `plane`, `quad` (`polygon`), `box`.
+//! - objects: `sphere`, `plane`, `quad` (`polygon`), `box`; an object's
+//!   `transform` after the shape as `scale`, `rotate`, `translate` (see
+//!   `placement`).
 //! - names: never written (comments say `lights[i]`, `objects[i]`): the
 //!   SDL holds only numbers and fixed keywords, whatever a scene contains.
-//! - refused (a clear error): an object's `transform`, a directional light's `radius`, a material's
+//! - refused (a clear error): a directional light's `radius`, a material's
 //!   `fresnel` (other than 1), `diffuse_f90` (other than 1), `specular2` on glass, `albedo_map`. `indirect_light` (the
 //!   built-in tracer's estimate) is not used: `render.indirect` is POV-Ray's.
 //! - material (kd, ks, n, kr, kt, ior; T = min(kt, MAX_TRANSMIT)):
@@ -39,7 +41,7 @@
 //!   bottom finish).
 
 use super::backend::Refusal;
-use crate::scene::{CameraKind, Falloff, LightKind, Material, Scene, Shape, Vec3};
+use crate::scene::{CameraKind, Falloff, LightKind, Material, Scene, Shape, Transform, Vec3};
 use std::f64::consts::PI;
 use std::fmt::Write;
 
@@ -106,12 +108,6 @@ pub fn refusals(scene: &Scene) -> Vec<Refusal> {
         }
     }
     for o in &scene.objects {
-        if o.transform.is_some() {
-            out.push(Refusal::new(
-                format!("objects.{}.transform", o.name),
-                "a placed object is drawn by phong only so far; use phong, or write the shape where it is",
-            ));
-        }
         let m = &o.material;
         if m.albedo_map.is_some() {
             out.push(Refusal::new(
@@ -224,8 +220,9 @@ pub fn sdl(scene: &Scene) -> Result<String, String> {
         // names are never written: the SDL holds only numbers and keywords
         let _ = writeln!(
             s,
-            "// objects[{i}]\n{shape}\n  {}\n}}",
-            material(&o.material)
+            "// objects[{i}]\n{shape}\n  {}{}\n}}",
+            material(&o.material),
+            o.transform.as_ref().map_or(String::new(), placement)
         );
     }
     Ok(s)
@@ -265,6 +262,21 @@ fn camera(s: &mut String, scene: &Scene) {
             );
         }
     }
+}
+
+/// An object's transform after its shape: `scale`, `rotate` (POV-Ray
+/// turns about x, then y, then z, as the scene does) and `translate`. The
+/// mirrored z turns a rotation about x or y the other way: P Rx(a) P =
+/// Rx(-a) with P = diag(1, 1, -1), while Rz and the scale are unchanged.
+fn placement(t: &Transform) -> String {
+    let sc = t.scale.map_or([1.0; 3], |k| k.axes());
+    let [rx, ry, rz] = t.rotate_deg.unwrap_or_default();
+    format!(
+        "\n  scale {} rotate {} translate {}",
+        vec(sc),
+        vec([-rx, -ry, rz]),
+        vec(pov(t.translate.unwrap_or_default()))
+    )
 }
 
 fn light(s: &mut String, i: usize, l: &crate::scene::Light) -> Result<(), String> {

@@ -48,12 +48,6 @@ fn scene_for(field: &str) -> Scene {
         "`render.max_depth` above 254" => s.render.max_depth = 255,
         "`material.diffuse_f90` (other than 1)" => m.diffuse_f90 = Some(0.5),
         "`material.albedo_map`" => m.albedo_map = Some("map.png".into()),
-        "`objects[].transform`" => {
-            s.objects[0].transform = Some(crate::scene::Transform {
-                translate: Some([0.0, 0.1, 0.0]),
-                ..Default::default()
-            })
-        }
         other => panic!("docs/renderers.md refuses {other:?}: add a scene for it here"),
     }
     s

@@ -3,11 +3,15 @@
 //! resolved once against a scene into a `Field`, which then reads and writes
 //! that value in any copy of the scene without string matching.
 //!
+//! An object's `objects.NAME.transform.translate|rotate_deg|scale` always
+//! resolves: an absent transform is the identity, written when first set.
+//!
 //! The optional effect fields (`indirect_light`, `lights.NAME.falloff_power|distance`,
 //! `objects.NAME.material.fresnel|specular2|shininess2|diffuse_f90`,
 //! `camera.vignetting.strength`, `camera.response.gain|gamma|black`) resolve
 //! only when the scene has them: set them first, then free them.
 
+use super::transform::{Scale, Transform};
 use super::types::{Scene, Vec3};
 
 /// A resolved numeric field of a scene.
@@ -20,6 +24,15 @@ pub enum Field {
     /// A shape's numeric field, by its name in the shape (`Shape::fields`).
     Shape(usize, &'static str),
     Camera(CameraField),
+    /// An object's `transform.translate|rotate_deg|scale` (absent: identity).
+    Transform(usize, TransformField),
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TransformField {
+    Translate,
+    RotateDeg,
+    Scale,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -95,9 +108,10 @@ impl Field {
             ["lights", name, field] => light_field(scene, name, field, path),
             ["objects", name, "material", field] => material_field(scene, name, field, path),
             ["objects", name, "shape", field] => shape_field(scene, name, field),
+            ["objects", name, "transform", field] => transform_field(scene, name, field),
             ["camera", field] => camera_field(scene, field),
             ["camera", group, field] => camera_group_field(scene, group, field, path),
-            _ => Err("expected ambient, indirect_light, lights.NAME.FIELD, objects.NAME.material.FIELD, objects.NAME.shape.FIELD or camera.FIELD".into()),
+            _ => Err("expected ambient, indirect_light, lights.NAME.FIELD, objects.NAME.material.FIELD, objects.NAME.shape.FIELD, objects.NAME.transform.FIELD or camera.FIELD".into()),
         }
     }
 
@@ -156,6 +170,7 @@ impl Field {
                     CameraField::WhiteBalance => Vector(c.white_balance?),
                 }
             }
+            Field::Transform(i, f) => transform_value(&scene.objects[i].transform, f),
         })
     }
 
@@ -169,6 +184,7 @@ impl Field {
             Field::Material(i, f) => set_material(&mut scene.objects[i].material, f, value),
             Field::Shape(i, f) => set_shape(&mut scene.objects[i].shape, f, value),
             Field::Camera(f) => set_camera(&mut scene.camera, f, value),
+            Field::Transform(i, f) => set_transform(&mut scene.objects[i].transform, f, value),
         }
     }
 
@@ -185,6 +201,9 @@ impl Field {
             }
             Field::Shape(i, f) => format!("objects.{}.shape.{f}", scene.objects[i].name),
             Field::Camera(f) => format!("camera.{}", f.key()),
+            Field::Transform(i, f) => {
+                format!("objects.{}.transform.{}", scene.objects[i].name, f.key())
+            }
         }
     }
 
@@ -211,6 +230,7 @@ impl Field {
                     | CameraField::FovY
                     | CameraField::Height
             ) | Field::Shape(..)
+                | Field::Transform(..)
                 | Field::Material(_, MaterialField::Ior)
         )
     }
@@ -260,6 +280,16 @@ impl MaterialField {
             MaterialField::Specular2 => "specular2",
             MaterialField::Shininess2 => "shininess2",
             MaterialField::DiffuseF90 => "diffuse_f90",
+        }
+    }
+}
+
+impl TransformField {
+    fn key(self) -> &'static str {
+        match self {
+            TransformField::Translate => "translate",
+            TransformField::RotateDeg => "rotate_deg",
+            TransformField::Scale => "scale",
         }
     }
 }
@@ -358,6 +388,51 @@ fn shape_field(scene: &Scene, name: &str, field: &str) -> Result<Field, String> 
             shape.type_name(),
             names.join(" or ")
         )),
+    }
+}
+
+/// `objects.NAME.transform.FIELD`: resolves whether or not the object has
+/// a transform (absent keys are the identity, written when first set).
+fn transform_field(scene: &Scene, name: &str, field: &str) -> Result<Field, String> {
+    let i = object(scene, name)?;
+    let f = match field {
+        "translate" => TransformField::Translate,
+        "rotate_deg" => TransformField::RotateDeg,
+        "scale" => TransformField::Scale,
+        other => {
+            return Err(format!(
+                "a transform has no field \"{other}\" (expected translate, rotate_deg or scale)"
+            ))
+        }
+    };
+    Ok(Field::Transform(i, f))
+}
+
+/// A transform's value; an absent one is the identity's. A scale is a
+/// number unless the scene gives one per axis.
+fn transform_value(t: &Option<Transform>, f: TransformField) -> Value {
+    let t = t.as_ref();
+    match f {
+        TransformField::Translate => Value::Vector(t.and_then(|t| t.translate).unwrap_or_default()),
+        TransformField::RotateDeg => {
+            Value::Vector(t.and_then(|t| t.rotate_deg).unwrap_or_default())
+        }
+        TransformField::Scale => match t.and_then(|t| t.scale) {
+            Some(Scale::Axes(v)) => Value::Vector(v),
+            Some(Scale::Uniform(x)) => Value::Scalar(x),
+            None => Value::Scalar(1.0),
+        },
+    }
+}
+
+fn set_transform(t: &mut Option<Transform>, f: TransformField, value: Value) {
+    let t = t.get_or_insert_with(Transform::default);
+    match (f, value) {
+        (TransformField::Translate, Value::Vector(v)) => t.translate = Some(v),
+        (TransformField::RotateDeg, Value::Vector(v)) => t.rotate_deg = Some(v),
+        (TransformField::Scale, Value::Vector(v)) => t.scale = Some(Scale::Axes(v)),
+        (TransformField::Scale, Value::Scalar(x)) => t.scale = Some(Scale::Uniform(x)),
+        _ => {}
     }
 }
 

@@ -4,7 +4,7 @@
 //! names the key path and what was expected.
 
 use super::checks::{finite3, non_negative, non_negative3, nonzero3, positive};
-use super::field::{Field, Value};
+use super::field::{Field, TransformField, Value};
 use super::limits::*;
 use super::types::*;
 use crate::error::{Error, Result};
@@ -430,6 +430,13 @@ fn free(scene: &Scene, f: &FreeParam, file: &str, at: &str) -> Result<()> {
     }
     if let Value::Scalar(_) = current {
         physical_minimum(&field, f, lo[0], file, at)?;
+    }
+    if matches!(field, Field::Transform(_, TransformField::Scale)) && lo.iter().any(|&x| x <= 0.0) {
+        return Err(Error::invalid(
+            file,
+            format!("{at}.min"),
+            format!("\"{}\" cannot go below or to 0", f.param),
+        ));
     }
     Ok(())
 }
