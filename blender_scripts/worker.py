@@ -35,6 +35,8 @@ about x: no mirroring).
 Camera
   perspective: sensor_fit VERTICAL, angle_y = fov_y_deg (vertical FOV).
   orthographic: sensor_fit VERTICAL, ortho_scale = height (vertical extent).
+  pinhole: as perspective, from fx, fy, cx, cy (Worker._apply_pinhole:
+    angle_y, pixel aspect, lens shift), placed by rotation and translation.
   Oriented from position / look_at / up (camera -Z looks at look_at, +Y is
   the component of `up` orthogonal to the view direction).  Clip range
   1e-4 .. 1e6 m.  Resolution image.width x image.height, 100 %, pixel
@@ -405,10 +407,10 @@ class Worker:
         cam_type, light_structs, obj_structs = structure
 
         # camera
-        if cam_type not in ("perspective", "orthographic"):
-            raise SceneError("camera.type must be 'perspective' or 'orthographic', got %r" % (cam_type,))
+        if cam_type not in ("perspective", "orthographic", "pinhole"):
+            raise SceneError("camera.type must be 'perspective', 'orthographic' or 'pinhole', got %r" % (cam_type,))
         cd = bpy.data.cameras.new(PREFIX + "camera")
-        cd.type = "PERSP" if cam_type == "perspective" else "ORTHO"
+        cd.type = "ORTHO" if cam_type == "orthographic" else "PERSP"
         cd.sensor_fit = "VERTICAL"
         cd.clip_start = 1e-4
         cd.clip_end = 1e6
@@ -614,7 +616,40 @@ class Worker:
             self._apply_shape(ent, o["shape"], "object '%s'" % o["name"])
             self._apply_material(ent, o["material"], desc["lights"])
 
+    def _apply_pinhole(self, cam):
+        """A calibrated pinhole (scene_common.pinhole): Blender's camera
+        looks along its -Z with +Y up, OpenCV's along +z with y down, so its
+        world matrix is B [R^T diag(1, -1, -1) | centre]. Sensor fit
+        VERTICAL: angle_y = 2 atan(H / (2 fy)); fx other than fy through the
+        pixel aspect (fx/fy = aspect_y / aspect_x, each at least 1); the
+        principal point through the lens shift, in units of the fitted
+        axis (ycor H pixels, ycor = fx/fy): shift_x = (W/2 - 1/2 - cx) /
+        (ycor H), shift_y = (cy + 1/2 - H/2) / H."""
+        rt = cam["to_world"]
+        cols = [Vector(tuple(rt[i][j] for i in range(3))) for j in range(3)]
+        m = Matrix((B(cols[0]), B(-cols[1]), B(-cols[2]))).transposed().to_4x4()
+        m.translation = B(cam["centre"])
+        key = (tuple(map(tuple, rt)), tuple(cam["centre"]))
+        if self.cam_key != key:
+            self.cam_obj.matrix_world = m
+            self.cam_key = key
+        r = self.scene.render
+        w, h = r.resolution_x, r.resolution_y
+        ycor = cam["fx"] / cam["fy"]
+        _set(r, "pixel_aspect_x", max(1.0, 1.0 / ycor))
+        _set(r, "pixel_aspect_y", max(1.0, ycor))
+        cd = self.cam_obj.data
+        _set(cd, "angle_y", 2.0 * math.atan(h / (2.0 * cam["fy"])))
+        _set(cd, "shift_x", (w / 2.0 - 0.5 - cam["cx"]) / (ycor * h))
+        _set(cd, "shift_y", (cam["cy"] + 0.5 - h / 2.0) / h)
+
     def _apply_camera(self, cam):
+        if cam["type"] == "pinhole":
+            self._apply_pinhole(cam)
+            return
+        r = self.scene.render
+        _set(r, "pixel_aspect_x", 1.0)
+        _set(r, "pixel_aspect_y", 1.0)
         pos = B(cam["position"])
         look = B(cam["look_at"])
         up = B(cam["up"])

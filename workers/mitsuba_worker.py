@@ -41,6 +41,8 @@ camera
                    s = height*width/(2*height_px) (Mitsuba's orthographic camera sees
                    x in [-1,1], y in [-1/aspect, 1/aspect] in camera space), so the
                    vertical extent is ``height`` metres.
+  pinhole       -> ``perspective`` (pinhole_plan): fov from fy, to_world from the
+                   rotation and centre, principal_point_offset from cx, cy.
   If up is parallel to the viewing direction, another up is chosen (world -z,
   or +x when looking along z) instead of failing.
   film: ``hdrfilm`` width x height from ``image``, pixel_format rgb, rfilter box.
@@ -208,8 +210,27 @@ def material_plan(m):
     }
 
 
+def pinhole_plan(cam, w, h):
+    """A calibrated pinhole as Mitsuba's ``perspective``: vertical fov
+    2 atan(H / (2 fy)); Mitsuba's camera x points left and y up in the
+    image, OpenCV's right and down, so to_world = [R^T diag(-1, -1, 1) |
+    centre], its x column scaled by fy/fx for non-square pixels; the
+    principal point through principal_point_offset (a fraction of the film,
+    moving the image against the axis): 0.5 - (cx + 0.5)/W, 0.5 - (cy + 0.5)/H."""
+    rt = cam["to_world"]
+    col = [tuple(rt[i][j] for i in range(3)) for j in range(3)]
+    fov = math.degrees(2.0 * math.atan(h / (2.0 * cam["fy"])))
+    return {"type": "perspective", "fov_y": fov,
+            "x_fov": math.degrees(2.0 * math.atan(math.tan(math.radians(fov) / 2.0) * w / h)),
+            "to_world": columns_matrix(mul(col[0], -cam["fy"] / cam["fx"]), mul(col[1], -1.0), col[2],
+                                       cam["centre"]),
+            "offset": (0.5 - (cam["cx"] + 0.5) / w, 0.5 - (cam["cy"] + 0.5) / h)}
+
+
 def camera_plan(cam, w, h):
-    camera = {"type": cam["type"]}
+    if cam["type"] == "pinhole":
+        return pinhole_plan(cam, w, h)
+    camera = {"type": cam["type"], "offset": (0.0, 0.0)}
     pos, target, up = cam["position"], cam["look_at"], cam["up"]
     if cam["type"] == "perspective":
         fov = cam["fov_y"]
@@ -609,6 +630,8 @@ class MitsubaBackend:
         if cam["type"] == "perspective":
             sensor["fov_axis"] = "y"
             sensor["fov"] = cam["fov_y"]
+            sensor["principal_point_offset_x"] = cam["offset"][0]
+            sensor["principal_point_offset_y"] = cam["offset"][1]
         if plan["indirect"]:
             integrator = {"type": "path", "hide_emitters": True, "max_depth": MAX_DEPTH_INDIRECT}
         elif DIRECT_WITH_PATH:
@@ -655,6 +678,8 @@ class MitsubaBackend:
         v["sensor.to_world"] = ("transform", cam["to_world"])
         if cam["type"] == "perspective":
             v["sensor.x_fov"] = ("float", cam["x_fov"])
+            v["sensor.principal_point_offset_x"] = ("float", cam["offset"][0])
+            v["sensor.principal_point_offset_y"] = ("float", cam["offset"][1])
         if plan["has_ambient"]:
             v["ambient.radiance.value"] = ("color", plan["ambient"])
         for i, L in enumerate(plan["lights"]):

@@ -7,7 +7,10 @@
 //!   which keeps the image the same with POV-Ray's left-handed camera.
 //! - `camera`: perspective (`angle` = horizontal field of view computed from
 //!   `fov_y_deg` and the aspect ratio) or orthographic (`up` = height, `right`
-//!   = height * aspect); `position`, `look_at`, `up` (as `sky`).
+//!   = height * aspect); `position`, `look_at`, `up` (as `sky`); `pinhole`:
+//!   a perspective camera with its own `direction`, `right` and `up`
+//!   built from fx, fy, cx, cy (see `pinhole_camera`); its `distortion` is
+//!   refused.
 //! - `ambient` A: `global_settings { ambient_light A }` and finish
 //!   `ambient kd` (unoccluded, as in Phong).
 //! - `render.max_depth` m: `max_trace_level` m + 1 (POV-Ray counts the camera ray).
@@ -41,6 +44,8 @@
 //!   bottom finish).
 
 use super::backend::Refusal;
+use crate::math::V3;
+use crate::scene::pinhole::Pinhole;
 use crate::scene::{CameraKind, Falloff, LightKind, Material, Scene, Shape, Transform, Vec3};
 use std::f64::consts::PI;
 use std::fmt::Write;
@@ -106,6 +111,9 @@ pub fn refusals(scene: &Scene) -> Vec<Refusal> {
                 "a directional light of angular size is not supported (POV-Ray's parallel lights are points at infinity); use phong or blender",
             ));
         }
+    }
+    if let Some(r) = super::pbr_fields::distortion(scene, "povray") {
+        out.push(r);
     }
     for o in &scene.objects {
         let m = &o.material;
@@ -237,31 +245,52 @@ const RADIOSITY: &str = "\n  radiosity { pretrace_start 0.08 pretrace_end 0.01 c
 
 fn camera(s: &mut String, scene: &Scene) {
     let c = &scene.camera;
-    let aspect = scene.image.width as f64 / scene.image.height as f64;
-    let common = format!("location {} sky {}", vec(pov(c.position)), vec(pov(c.up)));
-    match c.kind {
-        CameraKind::Perspective => {
-            let fov_y = c.fov_y_deg.unwrap_or(40.0).to_radians();
-            let fov_x = 2.0 * ((fov_y / 2.0).tan() * aspect).atan();
-            let _ = writeln!(
-                s,
-                "camera {{ perspective {common} right x*{} up y angle {} look_at {} }}",
-                num(aspect),
-                num(fov_x.to_degrees()),
-                vec(pov(c.look_at))
-            );
-        }
-        CameraKind::Orthographic => {
-            let h = c.height.unwrap_or(1.0);
-            let _ = writeln!(
-                s,
-                "camera {{ orthographic {common} right x*{} up y*{} look_at {} }}",
-                num(h * aspect),
-                num(h),
-                vec(pov(c.look_at))
-            );
-        }
+    if let Some(p) = Pinhole::of(c) {
+        let _ = writeln!(s, "{}", pinhole_camera(&p, scene.image));
+        return;
     }
+    let aspect = scene.image.width as f64 / scene.image.height as f64;
+    let common = format!("location {} sky {}", vec(pov(c.eye())), vec(pov(c.up)));
+    let look_at = vec(pov(c.target()));
+    if c.kind == CameraKind::Orthographic {
+        let h = c.height.unwrap_or(1.0);
+        let _ = writeln!(
+            s,
+            "camera {{ orthographic {common} right x*{} up y*{} look_at {look_at} }}",
+            num(h * aspect),
+            num(h),
+        );
+    } else {
+        let fov_y = c.fov_y_deg.unwrap_or(40.0).to_radians();
+        let fov_x = 2.0 * ((fov_y / 2.0).tan() * aspect).atan();
+        let _ = writeln!(
+            s,
+            "camera {{ perspective {common} right x*{} up y angle {} look_at {look_at} }}",
+            num(aspect),
+            num(fov_x.to_degrees()),
+        );
+    }
+}
+
+/// A calibrated pinhole (without distortion, which is refused) as POV-Ray's
+/// perspective camera with its own vectors: its ray through the screen
+/// point (sx, sy), each in [-0.5, 0.5] from the left and the bottom, is
+/// `direction + sx right + sy up`. The pixel whose centre is at sx, sy has
+/// OpenCV coordinates u = (sx + 1/2) W - 1/2, v = (1/2 - sy) H - 1/2, seen
+/// along ((u - cx)/fx, (v - cy)/fy, 1) in the camera's frame: so right =
+/// (W/fx, 0, 0), up = (0, -H/fy, 0) and direction = ((W/2 - 1/2 - cx)/fx,
+/// (H/2 - 1/2 - cy)/fy, 1), each carried into the world and mirrored.
+fn pinhole_camera(p: &Pinhole, size: crate::scene::ImageSize) -> String {
+    let (w, h) = (size.width as f64, size.height as f64);
+    let (fx, fy, cx, cy) = p.intrinsics();
+    let world = |v: [f64; 3]| vec(pov(p.camera_to_world(V3::from(v)).to_array()));
+    format!(
+        "camera {{ perspective location {} direction {} right {} up {} }}",
+        vec(pov(p.centre().to_array())),
+        world([(w / 2.0 - 0.5 - cx) / fx, (h / 2.0 - 0.5 - cy) / fy, 1.0]),
+        world([w / fx, 0.0, 0.0]),
+        world([0.0, -h / fy, 0.0]),
+    )
 }
 
 /// An object's transform after its shape: `scale`, `rotate` (POV-Ray

@@ -3,6 +3,9 @@
 //! resolved once against a scene into a `Field`, which then reads and writes
 //! that value in any copy of the scene without string matching.
 //!
+//! A pinhole camera's `camera.fx|fy|cx|cy|rotation|translation` and
+//! `camera.distortion.k1|k2|p1|p2|k3` (when it has `distortion`).
+//!
 //! An object's `objects.NAME.transform.translate|rotate_deg|scale` always
 //! resolves: an absent transform is the identity, written when first set.
 //!
@@ -74,7 +77,19 @@ pub enum CameraField {
     ResponseBlack,
     Exposure,
     WhiteBalance,
+    /// A pinhole camera's calibration (scene/pinhole.rs).
+    Fx,
+    Fy,
+    Cx,
+    Cy,
+    Rotation,
+    Translation,
+    /// `camera.distortion.k1|k2|p1|p2|k3`: coefficient i of the five.
+    Distortion(usize),
 }
+
+/// The names of a pinhole camera's distortion coefficients, in order.
+pub const DISTORTION_KEYS: [&str; 5] = ["k1", "k2", "p1", "p2", "k3"];
 
 /// A field's value: a number or a 3-vector.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -157,8 +172,8 @@ impl Field {
             Field::Camera(f) => {
                 let c = &scene.camera;
                 match f {
-                    CameraField::Position => Vector(c.position),
-                    CameraField::LookAt => Vector(c.look_at),
+                    CameraField::Position => Vector(c.position?),
+                    CameraField::LookAt => Vector(c.look_at?),
                     CameraField::Up => Vector(c.up),
                     CameraField::FovY => Scalar(c.fov_y_deg?),
                     CameraField::Height => Scalar(c.height?),
@@ -168,6 +183,13 @@ impl Field {
                     CameraField::ResponseBlack => Scalar(c.response?.black),
                     CameraField::Exposure => Scalar(c.exposure?),
                     CameraField::WhiteBalance => Vector(c.white_balance?),
+                    CameraField::Fx => Scalar(c.fx?),
+                    CameraField::Fy => Scalar(c.fy?),
+                    CameraField::Cx => Scalar(c.cx?),
+                    CameraField::Cy => Scalar(c.cy?),
+                    CameraField::Rotation => Vector(c.rotation?),
+                    CameraField::Translation => Vector(c.translation?),
+                    CameraField::Distortion(k) => Scalar(c.distortion?[k]),
                 }
             }
             Field::Transform(i, f) => transform_value(&scene.objects[i].transform, f),
@@ -229,6 +251,13 @@ impl Field {
                     | CameraField::Up
                     | CameraField::FovY
                     | CameraField::Height
+                    | CameraField::Fx
+                    | CameraField::Fy
+                    | CameraField::Cx
+                    | CameraField::Cy
+                    | CameraField::Rotation
+                    | CameraField::Translation
+                    | CameraField::Distortion(_)
             ) | Field::Shape(..)
                 | Field::Transform(..)
                 | Field::Material(_, MaterialField::Ior)
@@ -308,6 +337,17 @@ impl CameraField {
             CameraField::ResponseBlack => "response.black",
             CameraField::Exposure => "exposure",
             CameraField::WhiteBalance => "white_balance",
+            CameraField::Fx => "fx",
+            CameraField::Fy => "fy",
+            CameraField::Cx => "cx",
+            CameraField::Cy => "cy",
+            CameraField::Rotation => "rotation",
+            CameraField::Translation => "translation",
+            CameraField::Distortion(0) => "distortion.k1",
+            CameraField::Distortion(1) => "distortion.k2",
+            CameraField::Distortion(2) => "distortion.p1",
+            CameraField::Distortion(3) => "distortion.p2",
+            CameraField::Distortion(_) => "distortion.k3",
         }
     }
 }
@@ -446,6 +486,12 @@ fn camera_field(scene: &Scene, key: &str) -> Result<Field, String> {
         "height" => CameraField::Height,
         "exposure" => CameraField::Exposure,
         "white_balance" => CameraField::WhiteBalance,
+        "fx" => CameraField::Fx,
+        "fy" => CameraField::Fy,
+        "cx" => CameraField::Cx,
+        "cy" => CameraField::Cy,
+        "rotation" => CameraField::Rotation,
+        "translation" => CameraField::Translation,
         other => return Err(format!("the camera has no numeric field \"{other}\"")),
     };
     let resolved = Field::Camera(f);
@@ -467,9 +513,12 @@ fn camera_group_field(
         ("response", "gain") => CameraField::ResponseGain,
         ("response", "gamma") => CameraField::ResponseGamma,
         ("response", "black") => CameraField::ResponseBlack,
+        ("distortion", k) if DISTORTION_KEYS.contains(&k) => {
+            CameraField::Distortion(DISTORTION_KEYS.iter().position(|x| *x == k).unwrap_or(0))
+        }
         _ => {
             return Err(
-                "expected camera.vignetting.strength or camera.response.gain|gamma|black".into(),
+                "expected camera.vignetting.strength, camera.response.gain|gamma|black or camera.distortion.k1|k2|p1|p2|k3".into(),
             )
         }
     };
@@ -537,8 +586,8 @@ fn set_shape(sh: &mut super::types::Shape, name: &str, value: Value) {
 
 fn set_camera(c: &mut super::types::Camera, f: CameraField, value: Value) {
     match f {
-        CameraField::Position => v(&mut c.position, value),
-        CameraField::LookAt => v(&mut c.look_at, value),
+        CameraField::Position => ov(&mut c.position, value),
+        CameraField::LookAt => ov(&mut c.look_at, value),
         CameraField::Up => v(&mut c.up, value),
         CameraField::FovY => os(&mut c.fov_y_deg, value),
         CameraField::Height => os(&mut c.height, value),
@@ -564,6 +613,17 @@ fn set_camera(c: &mut super::types::Camera, f: CameraField, value: Value) {
         }
         CameraField::Exposure => os(&mut c.exposure, value),
         CameraField::WhiteBalance => ov(&mut c.white_balance, value),
+        CameraField::Fx => os(&mut c.fx, value),
+        CameraField::Fy => os(&mut c.fy, value),
+        CameraField::Cx => os(&mut c.cx, value),
+        CameraField::Cy => os(&mut c.cy, value),
+        CameraField::Rotation => ov(&mut c.rotation, value),
+        CameraField::Translation => ov(&mut c.translation, value),
+        CameraField::Distortion(k) => {
+            if let (Some(d), Value::Scalar(x)) = (c.distortion.as_mut(), value) {
+                d[k] = x;
+            }
+        }
     }
 }
 

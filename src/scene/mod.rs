@@ -11,6 +11,7 @@ pub mod load;
 pub mod memory;
 pub mod nuisance;
 pub mod params;
+pub mod pinhole;
 pub mod shape;
 #[cfg(test)]
 pub(crate) mod test_scene;
