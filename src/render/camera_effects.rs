@@ -186,21 +186,12 @@ fn powered(b: f64, gamma: f64) -> [f64; 256] {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scene::{CameraKind, Response, Vignetting};
+    use crate::scene::{Response, Vignetting};
 
     fn camera() -> Camera {
-        Camera {
-            kind: CameraKind::Perspective,
-            position: [0.0, 0.0, 5.0],
-            look_at: [0.0; 3],
-            up: [0.0, 1.0, 0.0],
-            fov_y_deg: Some(40.0),
-            height: None,
-            vignetting: None,
-            response: None,
-            exposure: None,
-            white_balance: None,
-        }
+        serde_json::from_value(serde_json::json!({"type": "perspective",
+            "position": [0.0, 0.0, 5.0], "look_at": [0.0, 0.0, 0.0], "fov_y_deg": 40.0}))
+        .unwrap()
     }
 
     #[test]

@@ -377,7 +377,7 @@ mod tests {
     #[test]
     fn culled_camera_rays_hit_what_every_primitive_would() {
         let mut beside = example("sphere_floor.json");
-        let cam = V3::from(beside.camera.position);
+        let cam = V3::from(beside.camera.eye());
         let c = cam + V3::new(0.6, 0.0, 0.0);
         beside.objects[0]
             .shape
