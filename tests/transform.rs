@@ -18,9 +18,10 @@ use scenefit::scene::parse;
 /// Blender 0.023, Mitsuba 0.091; a turn the wrong way 1.1.
 const BOUND: f64 = 0.3;
 
-/// A diffuse scene whose three objects are each placed by a transform
-/// that no symmetry hides: a turn the wrong way moves their edges.
-fn posed_scene(samples: u32, antialias: u32) -> serde_json::Value {
+/// A diffuse scene whose four objects are each placed by a transform
+/// that no symmetry hides: a turn the wrong way moves their edges; with
+/// `mesh`, the example blob mesh posed too (Mitsuba refuses a posed mesh).
+fn posed_scene(samples: u32, antialias: u32, mesh: bool) -> serde_json::Value {
     let mut s = diffuse_scene(samples, antialias);
     s["objects"] = serde_json::json!([
         {"name": "crate", "shape": {"type": "box", "min": [-0.5, -0.5, -0.5], "max": [0.5, 0.5, 0.5]},
@@ -36,6 +37,13 @@ fn posed_scene(samples: u32, antialias: u32) -> serde_json::Value {
          "transform": {"rotate_deg": [0, 0, 5]},
          "material": {"color": [1, 1, 1], "diffuse": 0.6}}
     ]);
+    if mesh {
+        let ply = root().join("scenes/mesh_blob.ply");
+        s["objects"].as_array_mut().unwrap().push(serde_json::json!(
+            {"name": "blob", "shape": {"type": "mesh", "file": ply},
+             "transform": {"scale": [0.3, 0.2, 0.25], "rotate_deg": [10, -30, 15], "translate": [0.9, 0.9, -0.5]},
+             "material": {"color": [0.3, 0.8, 0.4], "diffuse": 1.0}}));
+    }
     s
 }
 
@@ -43,16 +51,17 @@ fn posed_scene(samples: u32, antialias: u32) -> serde_json::Value {
 /// built-in tracer's (4x4 supersampled: edges area-averaged as the others'
 /// box filter does).
 fn posed_agreement(renderer: &str) -> f64 {
+    let mesh = renderer != "mitsuba";
     let scene = |v: &serde_json::Value| parse(&v.to_string(), "posed", &[]).unwrap();
     let phong = render_one(
         from_spec("phong").unwrap().as_ref(),
-        &scene(&posed_scene(64, 4)),
+        &scene(&posed_scene(64, 4, mesh)),
         0,
     )
     .expect("phong renders");
     let other = render_one(
         from_spec(renderer).unwrap().as_ref(),
-        &scene(&posed_scene(64, 4)),
+        &scene(&posed_scene(64, 4, mesh)),
         7,
     )
     .unwrap_or_else(|e| panic!("{renderer}: {e}"));
@@ -89,7 +98,7 @@ fn mitsuba_draws_posed_objects_where_phong_does() {
 fn a_turn_the_other_way_is_beyond_the_agreement_bound() {
     let scene = |v: &serde_json::Value| parse(&v.to_string(), "posed", &[]).unwrap();
     let phong = from_spec("phong").unwrap();
-    let right = posed_scene(1, 2);
+    let right = posed_scene(1, 2, false);
     let mut wrong = right.clone();
     for o in wrong["objects"].as_array_mut().unwrap() {
         if let Some(r) = o["transform"]["rotate_deg"].as_array_mut() {
@@ -112,7 +121,7 @@ fn a_turn_the_other_way_is_beyond_the_agreement_bound() {
 fn fit_recovers_a_crate_yaw_and_position() {
     let dir = tempdir();
     let d = dir.path();
-    let truth = posed_scene(1, 2);
+    let truth = posed_scene(1, 2, false);
     write_json(d, "truth.json", &truth);
     let mut start = truth.clone();
     start["objects"][0]["transform"]["rotate_deg"] = serde_json::json!([20, 20, -10]);
