@@ -543,6 +543,7 @@ fn finish(
         identifiability: None,
         deviation_precise: None,
         shots: None,
+        alternatives: Vec::new(),
     };
     result.check_finite()?;
     dir.write_json(FITTED_SCENE, &scene)?;
