@@ -30,6 +30,46 @@ pub struct LightPack {
     pub complex: Vec<(u32, u32)>,
 }
 
+impl LightPack {
+    /// The shadowing by light `l` of the hits in packed `order`.
+    fn of(paths: &Paths, order: &[u32], lights: usize, l: usize) -> LightPack {
+        let n = order.len();
+        let mut p = LightPack {
+            vis: vec![1.0; n],
+            qx: vec![0.0; n],
+            qy: vec![0.0; n],
+            qz: vec![0.0; n],
+            qc: vec![f32::INFINITY; n],
+            complex: Vec::new(),
+        };
+        for (k, &i) in order.iter().enumerate() {
+            match paths.shadow[i as usize * lights + l] {
+                Shadow::Lit => {}
+                Shadow::Dark => p.vis[k] = 0.0,
+                Shadow::Test { start, len } => {
+                    let occ = &paths.occluders[start as usize..(start + len) as usize];
+                    match occ {
+                        [Occluder::Cone {
+                            axis,
+                            cos_max,
+                            center_dist,
+                            ..
+                        }] => {
+                            let q = *axis * *center_dist;
+                            p.qx[k] = q.x as f32;
+                            p.qy[k] = q.y as f32;
+                            p.qz[k] = q.z as f32;
+                            p.qc[k] = (center_dist * center_dist * cos_max * cos_max) as f32;
+                        }
+                        _ => p.complex.push((k as u32, i)),
+                    }
+                }
+            }
+        }
+        p
+    }
+}
+
 pub struct Packed {
     pub n: usize,
     pub groups: Vec<Group>,
@@ -96,39 +136,7 @@ impl Packed {
             if cancelled() {
                 return None;
             }
-            let mut p = LightPack {
-                vis: vec![1.0; n],
-                qx: vec![0.0; n],
-                qy: vec![0.0; n],
-                qz: vec![0.0; n],
-                qc: vec![f32::INFINITY; n],
-                complex: Vec::new(),
-            };
-            for (k, &i) in order.iter().enumerate() {
-                match paths.shadow[i as usize * lights + l] {
-                    Shadow::Lit => {}
-                    Shadow::Dark => p.vis[k] = 0.0,
-                    Shadow::Test { start, len } => {
-                        let occ = &paths.occluders[start as usize..(start + len) as usize];
-                        match occ {
-                            [Occluder::Cone {
-                                axis,
-                                cos_max,
-                                center_dist,
-                                ..
-                            }] => {
-                                let q = *axis * *center_dist;
-                                p.qx[k] = q.x as f32;
-                                p.qy[k] = q.y as f32;
-                                p.qz[k] = q.z as f32;
-                                p.qc[k] = (center_dist * center_dist * cos_max * cos_max) as f32;
-                            }
-                            _ => p.complex.push((k as u32, i)),
-                        }
-                    }
-                }
-            }
-            packs.push(p);
+            packs.push(LightPack::of(paths, &order, lights, l));
         }
         let direct = paths.samples_per_pixel == 1 && v.iter().all(|x| x.parent == NO_PARENT);
         let coords: [fn(&Vertex) -> f64; 9] = [

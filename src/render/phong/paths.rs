@@ -165,50 +165,51 @@ impl Paths {
         } else {
             vec![trace_rows(0..h)]
         };
-        // The first part is taken as it is; the others are appended to it.
-        // Cut short on Ctrl-C too: on a large image the appending and the
-        // packing after it take seconds, and what is left of a cancelled
-        // build is never drawn (mod.rs), so it is left empty.
-        let cancelled = crate::exec::cancel::is_cancelled;
-        let mut parts = parts.into_iter();
-        let (verts, shadow, occluders) = match cancelled() {
-            false => parts.next().unwrap_or_default(),
-            true => Default::default(),
-        };
         let mut paths = Paths {
             width: w,
             height: h,
             samples_per_pixel: aa * aa,
-            verts,
-            shadow,
-            occluders,
+            verts: Vec::new(),
+            shadow: Vec::new(),
+            occluders: Vec::new(),
             geometry,
         };
+        paths.join(parts);
+        paths
+    }
+}
+
+impl Paths {
+    /// Appends the rows traced apart, in order, renumbering the links
+    /// between them. Cut short on Ctrl-C: on a large image the joining
+    /// and the packing after it take seconds, and what is left of a
+    /// cancelled build is never drawn (mod.rs), so it is left empty.
+    fn join(&mut self, parts: Vec<(Vec<Vertex>, Vec<Shadow>, Vec<Occluder>)>) {
+        let cancelled = crate::exec::cancel::is_cancelled;
         for (verts, shadow, occluders) in parts {
             if cancelled() {
-                paths.verts.clear();
-                paths.shadow.clear();
-                paths.occluders.clear();
-                break;
+                self.verts.clear();
+                self.shadow.clear();
+                self.occluders.clear();
+                return;
             }
-            let base_v = paths.verts.len() as u32;
-            let base_o = paths.occluders.len() as u32;
-            paths.verts.extend(verts.into_iter().map(|mut v| {
+            let base_v = self.verts.len() as u32;
+            let base_o = self.occluders.len() as u32;
+            self.verts.extend(verts.into_iter().map(|mut v| {
                 if v.parent != NO_PARENT {
                     v.parent += base_v;
                 }
                 v
             }));
-            paths.shadow.extend(shadow.into_iter().map(|s| match s {
+            self.shadow.extend(shadow.into_iter().map(|s| match s {
                 Shadow::Test { start, len } => Shadow::Test {
                     start: start + base_o,
                     len,
                 },
                 other => other,
             }));
-            paths.occluders.extend(occluders);
+            self.occluders.extend(occluders);
         }
-        paths
     }
 }
 
