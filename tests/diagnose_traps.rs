@@ -36,3 +36,49 @@ fn write_trap_sets() {
         );
     }
 }
+
+/// Fits `dir`'s set as a user would (`fit --shots`, nothing declared) and
+/// diagnoses it; diagnosis.json.
+fn fit_and_diagnose(dir: &Path) -> serde_json::Value {
+    for args in [
+        &[
+            "fit",
+            "scene.json",
+            "--shots",
+            "shots.json",
+            "-o",
+            "fit",
+            "--strategy",
+            "hybrid",
+            "--quiet",
+        ][..],
+        &["diagnose", "fit", "-o", "diag"][..],
+    ] {
+        let o = common::scenefit(dir, args);
+        assert!(o.status.success(), "{args:?}: {}", common::stderr(&o));
+    }
+    common::json(&dir.join("diag/diagnosis.json"))
+}
+
+fn accepted(d: &serde_json::Value) -> Vec<String> {
+    let list = d["accepted"].as_array().expect("accepted is a list");
+    list.iter()
+        .filter_map(|v| v.as_str().map(String::from))
+        .collect()
+}
+
+/// A real broad lobe in sRGB files: the model's lobe is no imitation, and
+/// no camera response may be taken for it (about 40 s).
+#[test]
+fn a_real_broad_lobe_takes_no_response() {
+    let dir = tempfile::tempdir().unwrap();
+    traps::write(dir.path(), Kind::Lobe, 200);
+    let d = fit_and_diagnose(dir.path());
+    let got = accepted(&d);
+    assert!(
+        !got.iter().any(|e| e == "camera_response"),
+        "accepted {got:?}"
+    );
+    // The keys issue 32 added are there, as lists.
+    assert!(d["removed"].is_array() && d["imitations"].is_array(), "{d}");
+}
