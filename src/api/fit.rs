@@ -94,6 +94,24 @@ impl Fitted {
     }
 }
 
+/// Refuses the fit when its `shots` photographs would need more memory
+/// than the machine has: the one estimate (`scene::memory`), from the
+/// scene's image size, the population and the jobs. A caller may check
+/// before it decodes any photograph (a huge image is then refused at
+/// once); `fit` checks again with the photographs it is given.
+pub fn check_memory(request: &FitRequest, shots: usize) -> Result<()> {
+    let FitRequest { scene, config, .. } = request;
+    let pop = Population {
+        option: "--population",
+        size: config.de.population,
+        copies: shots,
+    };
+    let size = (scene.image.width, scene.image.height);
+    let avail = crate::scene::memory::available();
+    let file = request.scene_file.display().to_string();
+    crate::scene::memory::check_fit(avail, &file, size, pop, config.jobs)
+}
+
 /// Fits `request.scene` to `photos` in the run directory `dir`, once the
 /// memory it needs has been checked.
 pub fn fit(
@@ -102,16 +120,7 @@ pub fn fit(
     dir: &Path,
     observer: &mut dyn Observer,
 ) -> Result<Fitted> {
-    let FitRequest { scene, config, .. } = &request;
-    let pop = Population {
-        option: "--population",
-        size: config.de.population,
-        copies: photos.shots.len(),
-    };
-    let size = (scene.image.width, scene.image.height);
-    let avail = crate::scene::memory::available();
-    let file = request.scene_file.display().to_string();
-    crate::scene::memory::check_fit(avail, &file, size, pop, config.jobs)?;
+    check_memory(&request, photos.shots.len())?;
     let mut config = request.config;
     config.inputs = request.inputs;
     config

@@ -11,7 +11,7 @@ mod report;
 
 pub use crate::diagnose::Diagnosis;
 pub use diagnose::{diagnose, DiagnoseRequest};
-pub use fit::{fit, FitRequest, Fitted, Photographs};
+pub use fit::{check_memory, fit, FitRequest, Fitted, Photographs};
 pub use report::{report, ReportRequest};
 
 pub use crate::diagnose::DiagnoseConfig;

@@ -75,9 +75,11 @@ impl FitInputs {
     }
 }
 
-/// Says `note` on stderr unless `quiet`.
-pub fn tell(note: Option<&str>, quiet: bool) {
-    if let (Some(n), false) = (note, quiet) {
+/// Says `note` (what was left out of the photographs: saturated, NaN or
+/// infinite pixels) on stderr, with `--quiet` too: it is about the data,
+/// not progress, and a user must not miss it.
+pub fn tell(note: Option<&str>) {
+    if let Some(n) = note {
         eprintln!("{n}");
     }
 }
@@ -132,7 +134,6 @@ pub fn run(a: FitArgs) -> Result<()> {
     }
     let mut scene = load_with(&a.inputs.scene, &a.set)?;
     crate::scene::nuisance::add(&mut scene, &a.nuisance);
-    let (photos, note) = a.inputs.photographs(&scene)?;
     let renderer = api::renderer(&a.renderer, &a.render_options.options_in(&a.output)?)?;
     let mut config = a.search.config(renderer.default_jobs())?;
     config.mode = run_mode(a.resume, a.overwrite);
@@ -151,10 +152,14 @@ pub fn run(a: FitArgs) -> Result<()> {
         rounds: a.rounds.unwrap_or(4),
         joint: a.joint,
     };
+    // Before any photograph is decoded: an image too large for this
+    // machine is refused at once, not after seconds of decoding.
+    api::check_memory(&request, 1)?;
+    let (photos, note) = a.inputs.photographs(&scene)?;
     let mut progress = Progress::new(a.quiet);
     let fitted = api::fit(request, &photos, &a.output, &mut progress)?;
     progress.finish();
-    tell(note.as_deref(), a.quiet);
+    tell(note.as_deref());
     if !a.quiet {
         println!("{}", summary(&fitted, photos.shots.len(), &a.output));
     }
