@@ -35,6 +35,8 @@ about x: no mirroring).
 Camera
   perspective: sensor_fit VERTICAL, angle_y = fov_y_deg (vertical FOV).
   orthographic: sensor_fit VERTICAL, ortho_scale = height (vertical extent).
+  pinhole: as perspective, from fx, fy, cx, cy (Worker._apply_pinhole:
+    angle_y, pixel aspect, lens shift), placed by rotation and translation.
   Oriented from position / look_at / up (camera -Z looks at look_at, +Y is
   the component of `up` orthogonal to the view direction).  Clip range
   1e-4 .. 1e6 m.  Resolution image.width x image.height, 100 %, pixel
@@ -62,6 +64,10 @@ Shapes
     rotated onto `normal`.
   quad: its own 4-vertex mesh corner, corner+u, corner+u+v, corner+v.
   box: a shared flat-shaded unit cube [0,1]^3, location = min, scale = size.
+  transform (an object's placement, scene_common.transform): every object
+    is the child of an empty whose world matrix is that transform in
+    Blender's frame (identity when absent), so the shape's own placement
+    above is kept as it is.
   Cycles shades both sides of every face.
 Materials (per object, linked to the object's material slot)
   specular = specular2 = reflection = transmission = 0 ("lambertian"):
@@ -426,10 +432,10 @@ class Worker:
         cam_type, light_structs, obj_structs = structure
 
         # camera
-        if cam_type not in ("perspective", "orthographic"):
-            raise SceneError("camera.type must be 'perspective' or 'orthographic', got %r" % (cam_type,))
+        if cam_type not in ("perspective", "orthographic", "pinhole"):
+            raise SceneError("camera.type must be 'perspective', 'orthographic' or 'pinhole', got %r" % (cam_type,))
         cd = bpy.data.cameras.new(PREFIX + "camera")
-        cd.type = "PERSP" if cam_type == "perspective" else "ORTHO"
+        cd.type = "ORTHO" if cam_type == "orthographic" else "PERSP"
         cd.sensor_fit = "VERTICAL"
         cd.clip_start = 1e-4
         cd.clip_end = 1e6
@@ -491,10 +497,13 @@ class Worker:
             ob = bpy.data.objects.new(PREFIX + "obj_" + name, me)
             ob.rotation_mode = "QUATERNION"
             coll.objects.link(ob)
+            place = bpy.data.objects.new(PREFIX + "place_" + name, None)
+            coll.objects.link(place)
+            ob.parent = place
             mat, nodes = self._make_material(PREFIX + "mat_" + name, mkind)
             ob.material_slots[0].link = "OBJECT"
             ob.material_slots[0].material = mat
-            self.objects.append({"obj": ob, "shape": stype, "mesh": own_mesh,
+            self.objects.append({"obj": ob, "place": place, "shape": stype, "mesh": own_mesh,
                                  "kind": mkind, "nodes": nodes, "mat": mat})
         self.structure = structure
 
@@ -631,10 +640,44 @@ class Worker:
         for (lo, fnode), L in zip(self.lights, desc["lights"]):
             self._apply_light(lo, fnode, L)
         for ent, o in zip(self.objects, desc["objects"]):
+            self._apply_place(ent["place"], o["transform"])
             self._apply_shape(ent, o["shape"], "object '%s'" % o["name"])
             self._apply_material(ent, o["material"], desc["lights"])
 
+    def _apply_pinhole(self, cam):
+        """A calibrated pinhole (scene_common.pinhole): Blender's camera
+        looks along its -Z with +Y up, OpenCV's along +z with y down, so its
+        world matrix is B [R^T diag(1, -1, -1) | centre]. Sensor fit
+        VERTICAL: angle_y = 2 atan(H / (2 fy)); fx other than fy through the
+        pixel aspect (fx/fy = aspect_y / aspect_x, each at least 1); the
+        principal point through the lens shift, in units of the fitted
+        axis (ycor H pixels, ycor = fx/fy): shift_x = (W/2 - 1/2 - cx) /
+        (ycor H), shift_y = (cy + 1/2 - H/2) / H."""
+        rt = cam["to_world"]
+        cols = [Vector(tuple(rt[i][j] for i in range(3))) for j in range(3)]
+        m = Matrix((B(cols[0]), B(-cols[1]), B(-cols[2]))).transposed().to_4x4()
+        m.translation = B(cam["centre"])
+        key = (tuple(map(tuple, rt)), tuple(cam["centre"]))
+        if self.cam_key != key:
+            self.cam_obj.matrix_world = m
+            self.cam_key = key
+        r = self.scene.render
+        w, h = r.resolution_x, r.resolution_y
+        ycor = cam["fx"] / cam["fy"]
+        _set(r, "pixel_aspect_x", max(1.0, 1.0 / ycor))
+        _set(r, "pixel_aspect_y", max(1.0, ycor))
+        cd = self.cam_obj.data
+        _set(cd, "angle_y", 2.0 * math.atan(h / (2.0 * cam["fy"])))
+        _set(cd, "shift_x", (w / 2.0 - 0.5 - cam["cx"]) / (ycor * h))
+        _set(cd, "shift_y", (cam["cy"] + 0.5 - h / 2.0) / h)
+
     def _apply_camera(self, cam):
+        if cam["type"] == "pinhole":
+            self._apply_pinhole(cam)
+            return
+        r = self.scene.render
+        _set(r, "pixel_aspect_x", 1.0)
+        _set(r, "pixel_aspect_y", 1.0)
         pos = B(cam["position"])
         look = B(cam["look_at"])
         up = B(cam["up"])
@@ -675,6 +718,16 @@ class Worker:
             _set(ld, "energy", L["intensity"])
             # the sun's angle is its angular diameter
             _set(ld, "angle", 2.0 * L["radius"])
+
+    def _apply_place(self, place, t):
+        """The object's transform in Blender's frame: B t B^-1 with
+        B (x, y, z) -> (x, -z, y)."""
+        m = Matrix.Identity(4)
+        if t is not None:
+            b = Matrix(((1, 0, 0, 0), (0, 0, -1, 0), (0, 1, 0, 0), (0, 0, 0, 1)))
+            m = b @ Matrix(t) @ b.inverted()
+        if place.matrix_world != m:
+            place.matrix_world = m
 
     def _apply_shape(self, ent, sh, where):
         ob = ent["obj"]

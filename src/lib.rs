@@ -2,6 +2,7 @@
 //! rendering in the loop. Data flows one way:
 //! scene -> parameter vector -> renderer -> image -> metric -> optimizer.
 
+pub mod api;
 pub mod cli;
 pub mod diagnose;
 pub mod error;

@@ -259,6 +259,9 @@ fn a_local_method_alone_fails_on_the_blobs_where_the_hybrid_succeeds() {
             radius: 0.0,
         };
         let mut local = Searcher::new(12, &config(Strategy::Hybrid, 1), start);
+        // A settling run draws no fresh population once this one is
+        // stuck, so it stays a local method alone.
+        local.settle();
         if run(&mut local, &problem, BLOB_TARGET, 120_000).is_none() {
             failures += 1;
         }
@@ -267,6 +270,27 @@ fn a_local_method_alone_fails_on_the_blobs_where_the_hybrid_succeeds() {
         failures > 0,
         "every local run succeeded: the test problem is too easy"
     );
+}
+
+#[test]
+fn a_stuck_population_is_followed_by_fresh_ones_that_find_the_target() {
+    // The starts of the test above, where a local method alone fails: the
+    // default hybrid, once its collapsed population is stuck, draws fresh
+    // populations over the whole cube (the restarts) and reaches the
+    // target from every one.
+    let problem = Blobs::new(&blob_truth());
+    let mut rng = ChaCha8Rng::seed_from_u64(11);
+    for i in 0..4 {
+        use rand::Rng;
+        let center: Vec<f64> = (0..12).map(|_| rng.gen::<f64>()).collect();
+        let start = Start::Around {
+            center: &center,
+            radius: 0.0,
+        };
+        let mut search = Searcher::new(12, &config(Strategy::Hybrid, 1), start);
+        let reached = run(&mut search, &problem, BLOB_TARGET, 120_000);
+        assert!(reached.is_some(), "start {i}: the target was not reached");
+    }
 }
 
 fn bits(v: &[f64]) -> Vec<u64> {

@@ -41,6 +41,8 @@ camera
                    s = height*width/(2*height_px) (Mitsuba's orthographic camera sees
                    x in [-1,1], y in [-1/aspect, 1/aspect] in camera space), so the
                    vertical extent is ``height`` metres.
+  pinhole       -> ``perspective`` (pinhole_plan): fov from fy, to_world from the
+                   rotation and centre, principal_point_offset from cx, cy.
   If up is parallel to the viewing direction, another up is chosen (world -z,
   or +x when looking along z) instead of failing.
   film: ``hdrfilm`` width x height from ``image``, pixel_format rgb, rfilter box.
@@ -81,6 +83,8 @@ objects
   quad    -> ``rectangle`` with to_world columns edge_u/2, edge_v/2,
              normalize(edge_u x edge_v), origin corner + (edge_u+edge_v)/2.
   box     -> ``cube`` mesh whose vertices are set to center + half_size * unit cube.
+  transform (an object's placement, scene_common.transform): its matrix times
+             the shape's to_world; for a box, applied to each vertex.
 materials (d = diffuse, c = color, ks = specular, n = shininess, kr = reflection,
   kt = transmission)
   ks = ks2 = kr = kt = 0 -> ``twosided`` ``diffuse`` with reflectance d*c
@@ -125,8 +129,8 @@ import sys
 import time
 
 import jsonlines
-from scene_common import (SceneError, add, cross, describe, mul, norm, normalize,
-                          roughness, sub)
+from scene_common import (SceneError, add, apply_point, cross, describe, matmul4, mul, norm,
+                          normalize, roughness, sub)
 
 LLVM19 = "/usr/lib/x86_64-linux-gnu/libLLVM-19.so"
 PLANE_HALF_SIZE = 1000.0
@@ -208,8 +212,27 @@ def material_plan(m):
     }
 
 
+def pinhole_plan(cam, w, h):
+    """A calibrated pinhole as Mitsuba's ``perspective``: vertical fov
+    2 atan(H / (2 fy)); Mitsuba's camera x points left and y up in the
+    image, OpenCV's right and down, so to_world = [R^T diag(-1, -1, 1) |
+    centre], its x column scaled by fy/fx for non-square pixels; the
+    principal point through principal_point_offset (a fraction of the film,
+    moving the image against the axis): 0.5 - (cx + 0.5)/W, 0.5 - (cy + 0.5)/H."""
+    rt = cam["to_world"]
+    col = [tuple(rt[i][j] for i in range(3)) for j in range(3)]
+    fov = math.degrees(2.0 * math.atan(h / (2.0 * cam["fy"])))
+    return {"type": "perspective", "fov_y": fov,
+            "x_fov": math.degrees(2.0 * math.atan(math.tan(math.radians(fov) / 2.0) * w / h)),
+            "to_world": columns_matrix(mul(col[0], -cam["fy"] / cam["fx"]), mul(col[1], -1.0), col[2],
+                                       cam["centre"]),
+            "offset": (0.5 - (cam["cx"] + 0.5) / w, 0.5 - (cam["cy"] + 0.5) / h)}
+
+
 def camera_plan(cam, w, h):
-    camera = {"type": cam["type"]}
+    if cam["type"] == "pinhole":
+        return pinhole_plan(cam, w, h)
+    camera = {"type": cam["type"], "offset": (0.0, 0.0)}
     pos, target, up = cam["position"], cam["look_at"], cam["up"]
     if cam["type"] == "perspective":
         fov = cam["fov_y"]
@@ -268,6 +291,10 @@ def object_plan(o):
         lo, hi = sh["min"], sh["max"]
         ob["center"] = mul(add(lo, hi), 0.5)
         ob["half"] = mul(sub(hi, lo), 0.5)
+    # the object's transform: after the shape's own placement
+    ob["transform"] = o["transform"]
+    if o["transform"] is not None and "to_world" in ob:
+        ob["to_world"] = matmul4(o["transform"], ob["to_world"])
     return ob
 
 
@@ -607,6 +634,8 @@ class MitsubaBackend:
         if cam["type"] == "perspective":
             sensor["fov_axis"] = "y"
             sensor["fov"] = cam["fov_y"]
+            sensor["principal_point_offset_x"] = cam["offset"][0]
+            sensor["principal_point_offset_y"] = cam["offset"][1]
         if plan["indirect"]:
             integrator = {"type": "path", "hide_emitters": True, "max_depth": MAX_DEPTH_INDIRECT}
         elif DIRECT_WITH_PATH:
@@ -657,6 +686,8 @@ class MitsubaBackend:
         v["sensor.to_world"] = ("transform", cam["to_world"])
         if cam["type"] == "perspective":
             v["sensor.x_fov"] = ("float", cam["x_fov"])
+            v["sensor.principal_point_offset_x"] = ("float", cam["offset"][0])
+            v["sensor.principal_point_offset_y"] = ("float", cam["offset"][1])
         if plan["has_ambient"]:
             v["ambient.radiance.value"] = ("color", plan["ambient"])
         for i, L in enumerate(plan["lights"]):
@@ -682,9 +713,9 @@ class MitsubaBackend:
         for i, O in enumerate(plan["objects"]):
             key = "O%d" % i
             if O["shape"] == "box":
-                v[key + ".vertex_positions"] = ("box", (O["center"], O["half"]))
+                v[key + ".vertex_positions"] = ("box", (O["center"], O["half"], O["transform"]))
             elif O["shape"] == "mesh":
-                pass  # drawn where the file puts it; nothing to move
+                pass  # drawn where the file puts it (a posed mesh is refused: pbr_fields.rs)
             else:
                 v[key + ".to_world"] = ("transform", O["to_world"])
             v.update(self.bsdf_values(key, O["material"]))
@@ -704,9 +735,11 @@ class MitsubaBackend:
         if kind == "transform":
             return type(self.params[key])(mi.ScalarTransform4f([list(r) for r in value]))
         if kind == "box":
-            center, half = value
+            center, half, place = value
             unit = self.unit_cubes[key]
             pos = [center[k % 3] + half[k % 3] * unit[k] for k in range(len(unit))]
+            if place is not None:
+                pos = [x for k in range(0, len(pos), 3) for x in apply_point(place, pos[k:k + 3])]
             return type(self.params[key])(pos)
         raise AssertionError(kind)
 

@@ -12,7 +12,10 @@ worker keeps its own arithmetic):
 
 - ``width``, ``height``, ``samples``, ``indirect``, ``ambient``;
 - ``camera``: ``type``, ``position``, ``look_at``, ``up`` and ``fov_y``
-  (perspective, degrees) or ``height`` (orthographic);
+  (perspective, degrees) or ``height`` (orthographic); or, for ``pinhole``,
+  ``fx``, ``fy``, ``cx``, ``cy`` (pixels), ``to_world`` (3x3 rows: the
+  OpenCV camera's x right, y down, z forward axes as columns) and
+  ``centre`` (see ``pinhole``);
 - ``lights``: ``name``, ``type`` (point or directional), ``color``,
   ``intensity``, ``radius``, and ``position`` and ``power`` (the falloff
   exponent: 1/d^power) or ``direction``;
@@ -235,7 +238,86 @@ def shape(sh, where):
     return out
 
 
+def rotation_xyz(deg):
+    """Rows of Rz Ry Rx for angles in degrees: about world x first."""
+    cx, cy, cz = (math.cos(math.radians(a)) for a in deg)
+    sx, sy, sz = (math.sin(math.radians(a)) for a in deg)
+    rx = ((1, 0, 0), (0, cx, -sx), (0, sx, cx))
+    ry = ((cy, 0, sy), (0, 1, 0), (-sy, 0, cy))
+    rz = ((cz, -sz, 0), (sz, cz, 0), (0, 0, 1))
+    return matmul3(rz, matmul3(ry, rx))
+
+
+def matmul3(a, b):
+    return tuple(tuple(sum(a[i][k] * b[k][j] for k in range(3)) for j in range(3)) for i in range(3))
+
+
+def transform(t, where):
+    """An object's `transform` as a 4x4 row-major matrix, or None."""
+    if t is None:
+        return None
+    if not isinstance(t, dict):
+        raise SceneError("%s: expected an object" % where)
+    unknown = set(t) - {"translate", "rotate_deg", "scale"}
+    if unknown:
+        raise SceneError("%s: unknown key %r" % (where, sorted(unknown)[0]))
+    move = vec3(t.get("translate", [0, 0, 0]), where + ".translate")
+    turn = vec3(t.get("rotate_deg", [0, 0, 0]), where + ".rotate_deg")
+    sc = t.get("scale", 1.0)
+    sc = vec3(sc, where + ".scale") if isinstance(sc, list) else (num(sc, where + ".scale"),) * 3
+    if any(k <= 0.0 for k in sc):
+        raise SceneError("%s.scale: must be > 0, got %r" % (where, t.get("scale")))
+    r = rotation_xyz(turn)
+    return tuple(tuple(r[i][j] * sc[j] for j in range(3)) + (move[i],) for i in range(3)) + ((0.0, 0.0, 0.0, 1.0),)
+
+
+def matmul4(a, b):
+    """a b for 4x4 row-major matrices (b applied first)."""
+    return tuple(tuple(sum(a[i][k] * b[k][j] for k in range(4)) for j in range(4)) for i in range(4))
+
+
+def apply_point(m, p):
+    """A 4x4 row-major affine matrix applied to a point."""
+    return tuple(m[i][0] * p[0] + m[i][1] * p[1] + m[i][2] * p[2] + m[i][3] for i in range(3))
+
+
+def rodrigues(r):
+    """Rows of the rotation of Rodrigues vector r (OpenCV's Rodrigues)."""
+    theta = norm(r)
+    if theta < 1e-300:
+        return ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
+    k = mul(r, 1.0 / theta)
+    c, s = math.cos(theta), math.sin(theta)
+    kx = ((0.0, -k[2], k[1]), (k[2], 0.0, -k[0]), (-k[1], k[0], 0.0))
+    return tuple(tuple((c if i == j else 0.0) + (1.0 - c) * k[i] * k[j] + s * kx[i][j]
+                       for j in range(3)) for i in range(3))
+
+
+def pinhole(cam, where):
+    """A calibrated camera in OpenCV's conventions (x right, y down, z
+    forward; pixel (0, 0) the centre of the top-left pixel): fx, fy, cx,
+    cy, ``to_world`` (rows of R^T: the camera's x, y, z axes as columns)
+    and ``centre`` (-R^T t). Distortion is refused by the Rust side."""
+    out = {"type": "pinhole"}
+    for key in ("fx", "fy", "cx", "cy"):
+        out[key] = num(cam.get(key), "%s.%s" % (where, key))
+    for key in ("fx", "fy"):
+        if out[key] <= 0.0:
+            raise SceneError("%s.%s: must be > 0, got %r" % (where, key, out[key]))
+    d = cam.get("distortion")
+    if d is not None and any(num(x, where + ".distortion") != 0.0 for x in d):
+        raise SceneError("%s.distortion: lens distortion is drawn by phong only" % where)
+    r = rodrigues(vec3(cam.get("rotation"), where + ".rotation"))
+    t = vec3(cam.get("translation"), where + ".translation")
+    rt = tuple(tuple(r[j][i] for j in range(3)) for i in range(3))
+    out["to_world"] = rt
+    out["centre"] = tuple(-sum(rt[i][j] * t[j] for j in range(3)) for i in range(3))
+    return out
+
+
 def camera(cam, where):
+    if cam.get("type") == "pinhole":
+        return pinhole(cam, where)
     out = {"type": cam.get("type", "perspective"),
            "position": vec3(cam.get("position"), where + ".position"),
            "look_at": vec3(cam.get("look_at"), where + ".look_at"),
@@ -251,7 +333,7 @@ def camera(cam, where):
         if out["height"] <= 0.0:
             raise SceneError("%s.height: must be > 0, got %r" % (where, out["height"]))
     else:
-        raise SceneError("%s.type: unknown %r (perspective or orthographic)" % (where, out["type"]))
+        raise SceneError("%s.type: unknown %r (perspective, orthographic or pinhole)" % (where, out["type"]))
     return out
 
 
@@ -272,7 +354,8 @@ def describe(scene):
     for name, where, o in named_entries(scene, "objects", "object"):
         objects.append({"name": name,
                         "shape": shape(obj(o, "shape", where), where + ".shape"),
-                        "material": material(o.get("material"), where + ".material")})
+                        "material": material(o.get("material"), where + ".material"),
+                        "transform": transform(o.get("transform"), where + ".transform")})
     return {
         "width": w, "height": h, "indirect": indirect,
         "samples": count(render, "samples", "render", 16),

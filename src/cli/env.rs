@@ -55,14 +55,18 @@ fn fill(mut o: RenderOptions, var: impl Fn(&str) -> Option<String>) -> Result<Re
     Ok(o)
 }
 
-/// Draws the report's figures with the font `flag` names, else the one
-/// `SCENEFIT_FONT` names, else a system font.
-pub fn use_font(flag: Option<PathBuf>) -> Result<()> {
-    let named = match flag {
+/// The report figures' font: the one `flag` names, else the one
+/// `SCENEFIT_FONT` names (None: a system font), with what named it.
+pub fn font(flag: Option<PathBuf>) -> Option<(&'static str, PathBuf)> {
+    match flag {
         Some(p) => Some(("--font", p)),
         None => std::env::var_os(FONT).map(|p| (FONT, PathBuf::from(p))),
-    };
-    match named {
+    }
+}
+
+/// Draws the report's figures with the font [`font`] finds.
+pub fn use_font(flag: Option<PathBuf>) -> Result<()> {
+    match font(flag) {
         Some((source, path)) => crate::report::font::use_file(source, path),
         None => Ok(()),
     }

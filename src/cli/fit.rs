@@ -1,16 +1,16 @@
-//! `scenefit fit SCENE --target IMG [--mask M] -o DIR [--renderer R] ...`
+//! `scenefit fit SCENE (--target IMG [--mask M] | --shots SHOTS.json) -o DIR [--renderer R] ...`:
+//! one photograph or a set, both through `api::fit` as a list of shots.
 
 use super::progress::Progress;
 use super::search::{self, Search};
+use crate::api::{self, FitRequest, Fitted, Photographs};
 use crate::error::{Error, Result};
-use crate::fit::{self, FitTarget};
+use crate::fit::FitTarget;
 use crate::raster::Encoding;
-use crate::render::from_spec_with;
 use crate::rundir::Mode;
-use crate::scene::memory::Population;
 use crate::scene::{load_with, Override, Scene};
 use clap::Args;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
 
@@ -51,11 +51,35 @@ impl FitInputs {
         let mask = self.mask.as_deref().map(|m| (m, "--mask"));
         FitTarget::from_photo(target, "--target", mask, self.encoding, size)
     }
+
+    /// The photographs to fit: the shots file's, or `--target` as a list
+    /// of one; with the line on saturated pixels left out.
+    pub fn photographs(&self, scene: &Scene) -> Result<(Photographs, Option<String>)> {
+        let Some(file) = &self.shots else {
+            let (target, note) = self.target(scene)?;
+            return Ok((Photographs::one(scene, target), note));
+        };
+        let (shots, notes) = crate::fit::set::shots::load(file, scene)?;
+        let note = notes.first().map(|first| {
+            format!(
+                "--shots: saturated pixels left out of the fit in {} of {} photographs (first: {first})",
+                notes.len(),
+                shots.len()
+            )
+        });
+        let photos = Photographs {
+            shots,
+            file: Some(file.clone()),
+        };
+        Ok((photos, note))
+    }
 }
 
-/// Says `note` on stderr unless `quiet`.
-pub fn tell(note: Option<&str>, quiet: bool) {
-    if let (Some(n), false) = (note, quiet) {
+/// Says `note` (what was left out of the photographs: saturated, NaN or
+/// infinite pixels) on stderr, with `--quiet` too: it is about the data,
+/// not progress, and a user must not miss it.
+pub fn tell(note: Option<&str>) {
+    if let Some(n) = note {
         eprintln!("{n}");
     }
 }
@@ -110,125 +134,60 @@ pub fn run(a: FitArgs) -> Result<()> {
     }
     let mut scene = load_with(&a.inputs.scene, &a.set)?;
     crate::scene::nuisance::add(&mut scene, &a.nuisance);
-    if let Some(shots) = &a.inputs.shots {
-        let (shots, notes) = crate::fit::set::shots::load(shots, &scene)?;
-        run_set(&a, &scene, &shots)?;
-        let note = notes.first().map(|first| {
-            format!(
-                "--shots: saturated pixels left out of the fit in {} of {} photographs (first: {first})",
-                notes.len(),
-                shots.len()
-            )
-        });
-        tell(note.as_deref(), a.quiet);
-        return Ok(());
-    }
-    let (target, note) = a.inputs.target(&scene)?;
-    let renderer = from_spec_with(&a.renderer, &a.render_options.options_in(&a.output)?)?;
+    let renderer = api::renderer(&a.renderer, &a.render_options.options_in(&a.output)?)?;
     let mut config = a.search.config(renderer.default_jobs())?;
-    let file = a.inputs.scene.display().to_string();
-    let (w, h) = (scene.image.width, scene.image.height);
-    let avail = crate::scene::memory::available();
-    let pop = Population {
-        option: "--population",
-        size: config.de.population,
-        copies: 1,
-    };
-    crate::scene::memory::check_fit(avail, &file, (w, h), pop, config.jobs)?;
     config.mode = run_mode(a.resume, a.overwrite);
-    if let Some(m) = &a.inputs.mask {
-        config.inputs.push(("--mask".into(), m.clone()));
-    }
-    config
-        .inputs
-        .push(("the scene".into(), a.inputs.scene.clone()));
     config.interrupt = Some(interrupt_flag());
+    let request = FitRequest {
+        scene: &scene,
+        scene_file: &a.inputs.scene,
+        inputs: a
+            .inputs
+            .mask
+            .iter()
+            .map(|m| ("--mask".into(), m.clone()))
+            .collect(),
+        renderer: renderer.as_ref(),
+        config,
+        rounds: a.rounds.unwrap_or(4),
+        joint: a.joint,
+    };
+    // Before any photograph is decoded: an image too large for this
+    // machine is refused at once, not after seconds of decoding.
+    api::check_memory(&request, 1)?;
+    let (photos, note) = a.inputs.photographs(&scene)?;
     let mut progress = Progress::new(a.quiet);
-    let outcome = fit::run(
-        &scene,
-        &target,
-        renderer.as_ref(),
-        &config,
-        &a.output,
-        &mut progress,
-    )?;
+    let fitted = api::fit(request, &photos, &a.output, &mut progress)?;
     progress.finish();
-    tell(note.as_deref(), a.quiet);
-    let result = outcome.result;
+    tell(note.as_deref());
     if !a.quiet {
-        let d = result.deviation;
-        println!(
-            "deviation %R {:.3} %G {:.3} %B {:.3} average {:.3}; {} renders in {:.1} s ({}); results in {}",
-            d.r,
-            d.g,
-            d.b,
-            d.average,
-            result.evaluations,
-            result.wall_seconds,
-            result.stop_reason,
-            a.output.display()
-        );
+        println!("{}", summary(&fitted, photos.shots.len(), &a.output));
     }
     Ok(())
 }
 
-/// `fit --shots`: one fit of every photograph of a set.
-fn run_set(a: &FitArgs, scene: &Scene, shots: &[crate::fit::set::shots::Shot]) -> Result<()> {
-    let renderer = from_spec_with(&a.renderer, &a.render_options.options_in(&a.output)?)?;
-    let mut config = a.search.config(renderer.default_jobs())?;
-    let file = a.inputs.scene.display().to_string();
-    let (w, h) = (scene.image.width, scene.image.height);
-    let avail = crate::scene::memory::available();
-    let pop = Population {
-        option: "--population",
-        size: config.de.population,
-        copies: shots.len(),
+/// The line a fit ends with: the deviation (over every photograph, and the
+/// worst one's, for a set), renders, time, why it stopped, where it wrote.
+fn summary(fitted: &Fitted, photographs: usize, dir: &Path) -> String {
+    let r = fitted.result();
+    let d = r.deviation;
+    let head = match fitted.worst() {
+        None => format!(
+            "deviation %R {:.3} %G {:.3} %B {:.3} average {:.3}",
+            d.r, d.g, d.b, d.average
+        ),
+        Some(worst) => format!(
+            "{photographs} photographs: average deviation {:.3} (worst photograph {worst:.3})",
+            d.average
+        ),
     };
-    crate::scene::memory::check_fit(avail, &file, (w, h), pop, config.jobs)?;
-    config.mode = run_mode(a.resume, a.overwrite);
-    config.interrupt = Some(interrupt_flag());
-    config
-        .inputs
-        .push(("the scene".into(), a.inputs.scene.clone()));
-    if let Some(s) = &a.inputs.shots {
-        config.inputs.push(("--shots".into(), s.clone()));
-    }
-    let set = fit::set::SetConfig {
-        spread: Vec::new(),
-        fit: config,
-        rounds: a.rounds.unwrap_or(4),
-        warm: false,
-        joint: a.joint,
-    };
-    let mut progress = Progress::new(a.quiet);
-    let outcome = fit::set::run(
-        scene,
-        shots,
-        renderer.as_ref(),
-        &set,
-        &a.output,
-        &mut progress,
-    )?;
-    progress.finish();
-    if !a.quiet {
-        let r = &outcome.result;
-        let worst = outcome
-            .shots
-            .iter()
-            .map(|s| s.result.deviation.average)
-            .fold(0.0, f64::max);
-        println!(
-            "{} photographs: average deviation {:.3} (worst photograph {:.3}); {} renders in {:.1} s ({}); results in {}",
-            shots.len(),
-            r.deviation.average,
-            worst,
-            r.evaluations,
-            r.wall_seconds,
-            r.stop_reason,
-            a.output.display()
-        );
-    }
-    Ok(())
+    format!(
+        "{head}; {} renders in {:.1} s ({}); results in {}",
+        r.evaluations,
+        r.wall_seconds,
+        r.stop_reason,
+        dir.display()
+    )
 }
 
 /// The run directory's mode from `--resume` and `--overwrite`.

@@ -1,10 +1,9 @@
 //! `scenefit render SCENE -o OUT.png [--renderer R] [--set P=V]... [--width W --height H]`
 
+use crate::api;
 use crate::error::{Error, Result};
 use crate::raster::io as image_io;
-use crate::render::{from_spec_with, render_one};
-use crate::scene::memory::Population;
-use crate::scene::{load_with, Override};
+use crate::scene::Override;
 use clap::Args;
 use std::path::PathBuf;
 
@@ -57,12 +56,13 @@ pub fn run(a: RenderArgs) -> Result<()> {
             });
         }
     }
-    let scene = load_with(&a.scene, &set)?;
-    // render_one draws one image with one job
-    let size = (scene.image.width, scene.image.height);
-    let file = a.scene.display().to_string();
-    crate::scene::memory::check(&file, size, Population::SINGLE, 1)?;
-    let renderer = from_spec_with(&a.renderer, &a.render_options.options()?)?;
-    let img = render_one(renderer.as_ref(), &scene, a.seed)?;
+    let scene = api::load_scene(&a.scene, &set)?;
+    let renderer = api::renderer(&a.renderer, &a.render_options.options()?)?;
+    let img = api::render(
+        &scene,
+        &a.scene.display().to_string(),
+        renderer.as_ref(),
+        a.seed,
+    )?;
     image_io::write_image(&img, &a.output)
 }

@@ -5,9 +5,9 @@
 //! diagnosis's (every photograph before and after), the report's figures
 //! are those of one photograph.
 
-use crate::error::{Error, Result};
-use crate::report::{self, ReportOptions};
-use crate::rundir::{Kind, RunDir, COMPARISON, REPORT, RESULT, SHOTS};
+use crate::api::{self, ReportRequest};
+use crate::error::Result;
+use crate::report::ReportOptions;
 use clap::Args;
 use std::path::PathBuf;
 
@@ -32,27 +32,14 @@ pub struct ReportArgs {
 }
 
 pub fn run(a: ReportArgs) -> Result<()> {
-    // Only a run's directory is locked (report refuses any other below,
-    // and leaves no lock file in it).
-    let is_run = [RESULT, COMPARISON].iter().any(|n| a.dir.join(n).is_file());
-    let _held = is_run
-        .then(|| RunDir::update(&a.dir, Kind::Fit))
-        .transpose()?;
-    if a.dir.join(SHOTS).is_file() {
-        return Err(Error::Usage(format!(
-            "{}: a fit of a set of photographs ({SHOTS}); report draws a fit of one photograph or a pipeline; `scenefit diagnose {} -o DIR` writes a set's {REPORT}",
-            a.dir.display(),
-            a.dir.display()
-        )));
-    }
-    super::env::use_font(a.font)?;
-    let path = report::write(
-        &a.dir,
-        &ReportOptions {
+    let request = ReportRequest {
+        options: ReportOptions {
             target: a.target,
             mask: a.mask,
         },
-    )?;
+        font: super::env::font(a.font),
+    };
+    let path = api::report(&a.dir, request)?;
     if !a.quiet {
         println!("{}", path.display());
     }

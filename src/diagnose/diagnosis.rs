@@ -46,6 +46,11 @@ pub struct Diagnosis {
     /// (shared geometry, `held.rs`); free again in improved_scene.json.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub held: Vec<String>,
+    /// Accepted effects the backward step took out again (`backward.rs`).
+    pub removed: Vec<Removal>,
+    /// Effects a round tried that explained the same residual as the one
+    /// it accepted, and why that one (`imitations.rs`).
+    pub imitations: Vec<Imitation>,
 }
 
 /// The name `accepted` gets when smooth structure remains.
@@ -66,4 +71,31 @@ pub struct SetDiagnosis {
     #[serde(flatten)]
     pub diagnosis: Diagnosis,
     pub shots_after: Vec<ShotAfter>,
+}
+
+/// An accepted effect the backward step removed (diagnosis.json's
+/// `removed`).
+#[derive(Clone, Debug, Serialize)]
+pub struct Removal {
+    pub effect: String,
+    /// The round after whose acceptance it was removed.
+    pub round: usize,
+    /// The criterion's change from the model without it to the model with
+    /// it (above −margin: it no longer pays for itself).
+    pub delta_bic: f64,
+    /// The relative drop of SAD it still gave.
+    pub gain: f64,
+    pub reason: String,
+}
+
+/// Two effects of one round that explain the same residual.
+#[derive(Clone, Debug, Serialize)]
+pub struct Imitation {
+    pub round: usize,
+    pub chosen: String,
+    pub other: String,
+    /// Correlation of the two refits' changes to the render (8-bit levels
+    /// over the mask, every photograph).
+    pub correlation: f64,
+    pub reason: String,
 }

@@ -19,11 +19,13 @@
 //! directory (`inputs.rs`); the files written are named in `rundir`.
 
 mod albedo;
+mod backward;
 mod config;
 mod diagnosis;
 pub mod effects;
 pub mod features;
 mod held;
+mod imitations;
 mod inputs;
 mod lanes;
 pub mod photo;
@@ -64,12 +66,17 @@ pub fn run(inputs: &Inputs, out: &Path, config: &DiagnoseConfig) -> Result<Diagn
     let mut model = fits.unchanged(Model::new(scene, image0, inputs))?;
     let refined = deviation(target, &model.image, mask);
 
+    let base = model.scene.clone();
     let mut candidates = Vec::new();
-    let mut accepted: Vec<String> = Vec::new();
+    let mut removed = Vec::new();
+    let mut imitations = Vec::new();
+    let mut steps: Vec<backward::Step> = Vec::new();
     for round in 1..=config.max_rounds {
-        let found = run_round(&mut fits, &model, &accepted, round, out)?;
+        let names: Vec<String> = steps.iter().map(|s| s.effect.name().to_string()).collect();
+        let found = run_round(&mut fits, &model, &names, round, out)?;
         candidates.extend(found.candidates);
-        let Some((name, next)) = found.accepted else {
+        imitations.extend(found.imitations);
+        let Some((step, next)) = found.accepted else {
             break;
         };
         model = next;
@@ -77,8 +84,14 @@ pub fn run(inputs: &Inputs, out: &Path, config: &DiagnoseConfig) -> Result<Diagn
             let polished = fits.run(&model.scene, None, Refine::polish(config))?;
             model = model.better(polished);
         }
-        accepted.push(name);
+        steps.push(step);
+        let c = selection::overdispersion([(target, &model.image, mask)]);
+        let n = samples(target, mask);
+        removed.extend(backward::prune(
+            &mut fits, &base, &mut steps, &mut model, n, c, config, round,
+        )?);
     }
+    let mut accepted: Vec<String> = steps.iter().map(|s| s.effect.name().to_string()).collect();
 
     let residual_after = Residual::new(target, &model.image, mask);
     let unexplained = residual_after.structured();
@@ -98,6 +111,8 @@ pub fn run(inputs: &Inputs, out: &Path, config: &DiagnoseConfig) -> Result<Diagn
         renders: fits.renders + 1,
         wall_seconds: started.elapsed().as_secs_f64(),
         held: held::paths(&held),
+        removed,
+        imitations,
     };
     albedo::prune(out, &model.scene);
     let residuals = (&residual_before, &residual_after);
@@ -109,7 +124,8 @@ pub fn run(inputs: &Inputs, out: &Path, config: &DiagnoseConfig) -> Result<Diagn
 /// report), and the accepted effect's name and model, if any.
 struct Round {
     candidates: Vec<Candidate>,
-    accepted: Option<(String, Model)>,
+    accepted: Option<(backward::Step, Model)>,
+    imitations: Vec<diagnosis::Imitation>,
 }
 
 /// One round: every applicable effect not yet accepted, extended, refitted
@@ -130,37 +146,45 @@ fn run_round(
         .collect();
     let searched: Vec<&dyn Effect> = open.iter().copied().filter(|e| !e.closed_form()).collect();
     let mut refitted = try_effects(fits, model, &searched, round)?.into_iter();
-    let mut tried: Vec<(Candidate, Model)> = Vec::new();
+    let mut tried: Vec<(Candidate, (Model, backward::Step))> = Vec::new();
     for effect in open {
         let found = if !effect.closed_form() {
             refitted.next().flatten()
         } else if effect.applies(&model.scene) {
-            albedo::candidate(effect.name(), fits, model, round, out)?
+            albedo::candidate(effect.name(), fits, model, round, out)?.map(|(c, m)| (c, m, 0))
         } else {
             None
         };
-        if let Some((c, m)) = found {
+        if let Some((c, m, form)) = found {
             let evidence = residual.evidence(effect);
-            tried.push((Candidate { evidence, ..c }, m));
+            let step = backward::Step { effect, form };
+            tried.push((Candidate { evidence, ..c }, (m, step)));
         }
     }
     tried.sort_by(|a, b| b.0.evidence.total_cmp(&a.0.evidence));
-    let (mut candidates, models): (Vec<Candidate>, Vec<Model>) = tried.into_iter().unzip();
+    let (mut candidates, models): (Vec<Candidate>, Vec<(Model, backward::Step)>) =
+        tried.into_iter().unzip();
     let mask = inputs.mask.as_ref();
     let n = samples(&inputs.target, mask);
-    let sads: Vec<f64> = models.iter().map(|m| m.sad).collect();
+    let sads: Vec<f64> = models.iter().map(|m| m.0.sad).collect();
     selection::weigh(&mut candidates, &sads, model.sad, n, |i| {
-        selection::overdispersion([(&inputs.target, &models[i].image, mask)])
+        selection::overdispersion([(&inputs.target, &models[i].0.image, mask)])
     });
     let chosen = selection::choose(&candidates, fits.config);
+    let imitations = chosen.map_or_else(Vec::new, |i| {
+        imitations::named(&candidates, i, |j| {
+            let (a, b) = (&models[i].0.image, &models[j].0.image);
+            imitations::correlation([(&model.image, a, b, mask)])
+        })
+    });
     let accepted = chosen.and_then(|i| {
         candidates[i].accepted = true;
-        let name = candidates[i].effect.clone();
-        models.into_iter().nth(i).map(|m| (name, m))
+        models.into_iter().nth(i).map(|(m, step)| (step, m))
     });
     Ok(Round {
         candidates,
         accepted,
+        imitations,
     })
 }
 
@@ -174,19 +198,21 @@ struct Trial {
     radius: f64,
     /// Free values added.
     added: usize,
+    /// Which of the effect's forms.
+    form: usize,
 }
 
 /// Each effect added to `model` and refitted warm (from its best start)
 /// and, when configured, from scratch, in each of its forms; the best
 /// refit counts. None for an effect that does not apply. Every refit of
 /// the round runs side by side with the others (`lanes.rs`); candidates'
-/// evidence is left at 0.
+/// evidence is left at 0. Each with the index of its form.
 fn try_effects(
     fits: &mut Refits,
     model: &Model,
     effects: &[&'static dyn Effect],
     round: usize,
-) -> Result<Vec<Option<(Candidate, Model)>>> {
+) -> Result<Vec<Option<(Candidate, Model, usize)>>> {
     let prepared: Vec<Vec<Trial>> =
         lanes::side_by_side(fits, effects, |f, &e| prepare(f, model, e))
             .into_iter()
@@ -251,7 +277,7 @@ fn try_effects(
                     t.added,
                     refit,
                 );
-                (c, fitted)
+                (c, fitted, t.form)
             })
         })
         .collect())
@@ -262,7 +288,7 @@ fn try_effects(
 fn prepare(fits: &mut Refits, model: &Model, effect: &'static dyn Effect) -> Result<Vec<Trial>> {
     let k0 = ParamSpace::from_scene(&model.scene).dim();
     let mut trials = Vec::new();
-    for ext in effects::forms(effect, &model.scene) {
+    for (form, ext) in effects::forms(effect, &model.scene).into_iter().enumerate() {
         let added = ParamSpace::from_scene(&ext.scene).dim() - k0;
         let (start, count) = starts::best_start(fits.renderer(), &ext, fits.inputs)?;
         fits.renders += count;
@@ -273,6 +299,7 @@ fn prepare(fits: &mut Refits, model: &Model, effect: &'static dyn Effect) -> Res
             radius: trades.radius,
             start,
             added,
+            form,
         });
     }
     Ok(trials)

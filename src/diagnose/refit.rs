@@ -213,6 +213,27 @@ impl<'a> Refits<'a> {
     }
 }
 
+impl super::backward::Models for Refits<'_> {
+    type Model = Model;
+
+    fn scene<'m>(&self, m: &'m Model) -> &'m Scene {
+        &m.scene
+    }
+
+    fn score(&self, m: &Model) -> (f64, usize) {
+        (m.sad, crate::scene::ParamSpace::from_scene(&m.scene).dim())
+    }
+
+    /// Each scene refitted as the unchanged model is, warm.
+    fn refit_all(&mut self, scenes: Vec<Scene>, _from: &Model) -> Result<Vec<Model>> {
+        let c = self.config;
+        let warm = Refine::close(c, c.search_generations + c.refine_generations);
+        super::lanes::side_by_side(self, &scenes, |f, s| f.run(s, None, warm))
+            .into_iter()
+            .collect()
+    }
+}
+
 impl super::lanes::Lanes for Refits<'_> {
     fn jobs(&self) -> usize {
         self.jobs

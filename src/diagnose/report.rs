@@ -136,6 +136,13 @@ fn summary(page: &mut Page, d: &Diagnosis) {
             d.held.join(", ")
         ));
     }
+    // The same lines as diagnosis.json's `imitations` and `removed`.
+    for line in d.imitations.iter().map(|i| &i.reason) {
+        page.p(&format!("Imitation: {line}."));
+    }
+    for line in d.removed.iter().map(|r| &r.reason) {
+        page.p(&format!("Removed: {line}."));
+    }
     page.h2("Deviation per channel (%)", "deviation");
     page.table(
         &["", "r", "g", "b", "average"],
@@ -231,10 +238,19 @@ mod tests {
             renders: 1234,
             wall_seconds: 5.0,
             held: Vec::new(),
+            removed: Vec::new(),
+            imitations: vec![super::super::diagnosis::Imitation {
+                round: 1,
+                chosen: "vignetting".into(),
+                other: "ambient".into(),
+                correlation: 0.9,
+                reason: "vignetting and ambient explain the same residual".into(),
+            }],
         };
         let page = html(&d, 0.05);
         for part in [
             "<b>vignetting</b>. 1234 renders in 5.0 s.",
+            "Imitation: vignetting and ambient explain the same residual.",
             "<td class=\"l\">refitted, no effect</td><td>0.600</td>",
             "full colour = 0.0500 linear",
             "src=\"residual_before.png\"",

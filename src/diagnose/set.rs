@@ -16,6 +16,8 @@
 pub use super::diagnosis::{SetDiagnosis, ShotAfter};
 pub use super::inputs::SetInputs;
 
+use super::backward::{prune, Removal, Step};
+use super::diagnosis::Imitation;
 use super::effects::{self, Effect};
 use super::residual::Residual;
 use super::selection::{choose, overdispersion, samples, weigh};
@@ -63,7 +65,12 @@ pub fn run(inputs: &SetInputs, out: &Path, config: &DiagnoseConfig) -> Result<Se
         .iter()
         .map(|s| samples(&s.target.image, s.target.mask.as_ref()))
         .sum();
-    let (candidates, mut accepted) = rounds(&mut fits, &mut model, n)?;
+    let Rounds {
+        candidates,
+        mut accepted,
+        removed,
+        imitations,
+    } = rounds(&mut fits, &mut model, n)?;
     if !accepted.is_empty() {
         // The last refit stopped where block descent slows: along a valley
         // where shared and per-shot values trade. A warm refit from there
@@ -91,6 +98,8 @@ pub fn run(inputs: &SetInputs, out: &Path, config: &DiagnoseConfig) -> Result<Se
         renders: fits.renders,
         wall_seconds: started.elapsed().as_secs_f64(),
         held: super::held::paths(&held),
+        removed,
+        imitations,
     };
     let d = SetDiagnosis {
         diagnosis,
@@ -127,86 +136,156 @@ fn shots_after(
         .collect()
 }
 
+/// What the rounds of a set found.
+struct Rounds {
+    candidates: Vec<Candidate>,
+    accepted: Vec<String>,
+    removed: Vec<Removal>,
+    imitations: Vec<Imitation>,
+}
+
 /// The rounds: every effect not yet accepted tried on the set, the
-/// criterion choosing; `model` becomes the accepted one. The candidates
-/// of every round and the effects accepted.
-fn rounds(
+/// criterion choosing; `model` becomes the accepted one, and after each
+/// acceptance the backward step (`backward.rs`) may take an earlier one
+/// out. The candidates of every round, the effects accepted and those
+/// removed.
+fn rounds(fits: &mut SetRefits, model: &mut SetModel, n: f64) -> Result<Rounds> {
+    let base = model.scene.clone();
+    let mut candidates = Vec::new();
+    let mut steps: Vec<Step> = Vec::new();
+    let mut removed = Vec::new();
+    let mut imitations = Vec::new();
+    for round in 1..=fits.config.max_rounds {
+        let accepted: Vec<String> = steps.iter().map(|s| s.effect.name().to_string()).collect();
+        let (found, chosen, named) = round_of(fits, model, &accepted, n, round)?;
+        candidates.extend(found);
+        imitations.extend(named);
+        let Some(step) = chosen else {
+            break;
+        };
+        steps.push(step);
+        let c = overdispersion_of(model, fits.inputs);
+        removed.extend(prune(
+            fits,
+            &base,
+            &mut steps,
+            model,
+            n,
+            c,
+            fits.config,
+            round,
+        )?);
+    }
+    let accepted = steps.iter().map(|s| s.effect.name().to_string()).collect();
+    Ok(Rounds {
+        candidates,
+        accepted,
+        removed,
+        imitations,
+    })
+}
+
+/// The overdispersion of `model`'s residuals over every photograph.
+fn overdispersion_of(model: &SetModel, inputs: &SetInputs) -> f64 {
+    let pairs = model.images.iter().zip(&inputs.shots);
+    overdispersion(pairs.map(|(img, s)| (&s.target.image, img, s.target.mask.as_ref())))
+}
+
+/// One round: every effect not in `accepted` tried on the set; its
+/// candidates, and the accepted effect's step (`model` then its model).
+fn round_of(
     fits: &mut SetRefits,
     model: &mut SetModel,
+    accepted: &[String],
     n: f64,
-) -> Result<(Vec<Candidate>, Vec<String>)> {
+    round: usize,
+) -> Result<(Vec<Candidate>, Option<Step>, Vec<Imitation>)> {
     let inputs = fits.inputs;
-    let mut candidates = Vec::new();
-    let mut accepted: Vec<String> = Vec::new();
-    for round in 1..=fits.config.max_rounds {
-        let residuals = model.residuals(inputs);
-        let k0 = model.dim(inputs);
-        let open: Vec<&dyn Effect> = effects::ALL
-            .iter()
-            .copied()
-            .filter(|e| !accepted.iter().any(|a| a == e.name()))
-            .collect();
-        // The searched effects' refits side by side (`lanes.rs`).
-        let searched: Vec<&dyn Effect> =
-            open.iter().copied().filter(|e| !e.closed_form()).collect();
-        let best = refit_effects(fits, model, &searched)?;
-        let mut refitted = best.into_iter();
-        let mut tried: Vec<(Candidate, SetModel)> = Vec::new();
-        for effect in open {
-            let (fitted, k) = if effect.closed_form() {
-                let solved = match effect.applies(&model.scene) {
-                    true => super::albedo::set_model(fits, model, round)?,
-                    false => None,
-                };
-                let Some((fitted, values)) = solved else {
-                    continue;
-                };
-                let k = fitted.dim(inputs) + values;
-                (fitted, k)
-            } else {
-                let Some(fitted) = refitted.next().expect("one result per searched effect") else {
-                    continue;
-                };
-                let k = fitted.dim(inputs);
-                (fitted, k)
+    let residuals = model.residuals(inputs);
+    let k0 = model.dim(inputs);
+    let open: Vec<&dyn Effect> = effects::ALL
+        .iter()
+        .copied()
+        .filter(|e| !accepted.iter().any(|a| a == e.name()))
+        .collect();
+    // The searched effects' refits side by side (`lanes.rs`).
+    let searched: Vec<&dyn Effect> = open.iter().copied().filter(|e| !e.closed_form()).collect();
+    let best = refit_effects(fits, model, &searched)?;
+    let mut refitted = best.into_iter();
+    let mut tried: Vec<(Candidate, (SetModel, Step))> = Vec::new();
+    for effect in open {
+        let (fitted, k, form) = if effect.closed_form() {
+            let solved = match effect.applies(&model.scene) {
+                true => super::albedo::set_model(fits, model, round)?,
+                false => None,
             };
-            let candidate = Candidate {
-                effect: effect.name().to_string(),
-                evidence: evidence(&residuals, effect),
-                deviation_after: Some(pooled(&fitted.deviations(inputs), inputs)),
-                round,
-                delta_bic: None,
-                overdispersion: None,
-                gain: Some(1.0 - fitted.sad / model.sad.max(1e-9)),
-                added_params: k.saturating_sub(k0),
-                accepted: false,
-                refit: "warm (set)".into(),
+            let Some((fitted, values)) = solved else {
+                continue;
             };
-            tried.push((candidate, fitted));
-        }
-        tried.sort_by(|a, b| b.0.evidence.total_cmp(&a.0.evidence));
-        let (mut found, models): (Vec<Candidate>, Vec<SetModel>) = tried.into_iter().unzip();
-        weigh_round(&mut found, &models, model.sad, n, inputs);
-        let chosen = choose(&found, fits.config);
-        if let Some(i) = chosen {
-            found[i].accepted = true;
-            accepted.push(found[i].effect.clone());
-            let warm = models.into_iter().nth(i).expect("chosen from these");
-            let scratch = fits.scratch(&warm.scene, &warm.own)?;
-            if scratch.sad < warm.sad {
-                found[i].refit = "warm (set), then from scratch (set)".into();
-                found[i].deviation_after = Some(pooled(&scratch.deviations(inputs), inputs));
-                *model = scratch;
-            } else {
-                *model = warm;
-            }
-        }
-        candidates.extend(found);
-        if chosen.is_none() {
-            break;
+            let k = fitted.dim(inputs) + values;
+            (fitted, k, 0)
+        } else {
+            let Some((fitted, form)) = refitted.next().expect("one result per searched effect")
+            else {
+                continue;
+            };
+            let k = fitted.dim(inputs);
+            (fitted, k, form)
+        };
+        let candidate = Candidate {
+            effect: effect.name().to_string(),
+            evidence: evidence(&residuals, effect),
+            deviation_after: Some(pooled(&fitted.deviations(inputs), inputs)),
+            round,
+            delta_bic: None,
+            overdispersion: None,
+            gain: Some(1.0 - fitted.sad / model.sad.max(1e-9)),
+            added_params: k.saturating_sub(k0),
+            accepted: false,
+            refit: "warm (set)".into(),
+        };
+        tried.push((candidate, (fitted, Step { effect, form })));
+    }
+    tried.sort_by(|a, b| b.0.evidence.total_cmp(&a.0.evidence));
+    let (mut found, models): (Vec<Candidate>, Vec<(SetModel, Step)>) = tried.into_iter().unzip();
+    let (models, forms): (Vec<SetModel>, Vec<Step>) = models.into_iter().unzip();
+    weigh_round(&mut found, &models, model.sad, n, inputs);
+    let chosen = choose(&found, fits.config);
+    let named = chosen.map_or_else(Vec::new, |i| {
+        imitations_of(&found, i, &models, model, inputs)
+    });
+    if let Some(i) = chosen {
+        found[i].accepted = true;
+        let warm = models.into_iter().nth(i).expect("chosen from these");
+        let scratch = fits.scratch(&warm.scene, &warm.own)?;
+        if scratch.sad < warm.sad {
+            found[i].refit = "warm (set), then from scratch (set)".into();
+            found[i].deviation_after = Some(pooled(&scratch.deviations(inputs), inputs));
+            *model = scratch;
+        } else {
+            *model = warm;
         }
     }
-    Ok((candidates, accepted))
+    Ok((found, chosen.map(|i| forms[i]), named))
+}
+
+/// The effects of a round whose refits changed the renders as the
+/// chosen one's did (`imitations.rs`), over every photograph.
+fn imitations_of(
+    found: &[Candidate],
+    chosen: usize,
+    models: &[SetModel],
+    model: &SetModel,
+    inputs: &SetInputs,
+) -> Vec<Imitation> {
+    super::imitations::named(found, chosen, |j| {
+        let views = (0..inputs.shots.len()).map(|s| {
+            let mask = inputs.shots[s].target.mask.as_ref();
+            let (a, b) = (&models[chosen].images[s], &models[j].images[s]);
+            (&model.images[s], a, b, mask)
+        });
+        super::imitations::correlation(views)
+    })
 }
 
 /// The round's criterion changes from a model with SAD `sad0`, the
@@ -231,18 +310,19 @@ fn weigh_round(
 fn refit_effects(
     fits: &mut SetRefits,
     model: &SetModel,
-    searched: &[&dyn Effect],
-) -> Result<Vec<Option<SetModel>>> {
-    let forms: Vec<(usize, effects::Extension)> = searched
+    searched: &[&'static dyn Effect],
+) -> Result<Vec<Option<(SetModel, usize)>>> {
+    let forms: Vec<(usize, usize, effects::Extension)> = searched
         .iter()
         .enumerate()
         .flat_map(|(i, &e)| {
             effects::forms(e, &model.scene)
                 .into_iter()
-                .map(move |x| (i, x))
+                .enumerate()
+                .map(move |(form, x)| (i, form, x))
         })
         .collect();
-    let done = super::lanes::side_by_side(fits, &forms, |f, (i, ext)| {
+    let done = super::lanes::side_by_side(fits, &forms, |f, (i, _, ext)| {
         let (start, own) = f.best_start(ext, &model.own)?;
         // The effect's own parameters spread as its refit for one
         // photograph spreads them: they hold a neutral guess, not a fit.
@@ -254,12 +334,12 @@ fn refit_effects(
             .collect();
         f.run_spread(&start, &own, spread)
     });
-    let mut best: Vec<Option<SetModel>> = searched.iter().map(|_| None).collect();
-    for ((i, _), fitted) in forms.iter().zip(done) {
+    let mut best: Vec<Option<(SetModel, usize)>> = searched.iter().map(|_| None).collect();
+    for ((i, form, _), fitted) in forms.iter().zip(done) {
         let fitted = fitted?;
         best[*i] = Some(match best[*i].take() {
-            Some(b) => b.better(fitted),
-            None => fitted,
+            Some(b) if b.0.sad <= fitted.sad => b,
+            _ => (fitted, *form),
         });
     }
     Ok(best)

@@ -106,6 +106,38 @@ pub(super) struct SetRefits<'a> {
     pub(super) out: &'a Path,
 }
 
+impl super::backward::Models for SetRefits<'_> {
+    type Model = SetModel;
+
+    fn scene<'m>(&self, m: &'m SetModel) -> &'m Scene {
+        &m.scene
+    }
+
+    fn score(&self, m: &SetModel) -> (f64, usize) {
+        (m.sad, m.dim(self.inputs))
+    }
+
+    /// Each scene refitted over the set, warm, every photograph's own
+    /// values those of `from` that the scene still frees.
+    fn refit_all(&mut self, scenes: Vec<Scene>, from: &SetModel) -> Result<Vec<SetModel>> {
+        super::lanes::side_by_side(self, &scenes, |f, s| {
+            let own: Vec<Params> = from
+                .own
+                .iter()
+                .map(|o| {
+                    let kept = o
+                        .iter()
+                        .filter(|(k, _)| s.free.iter().any(|p| &p.param == *k));
+                    kept.map(|(k, v)| (k.clone(), v.clone())).collect()
+                })
+                .collect();
+            f.run(s, &own)
+        })
+        .into_iter()
+        .collect()
+    }
+}
+
 impl super::lanes::Lanes for SetRefits<'_> {
     fn jobs(&self) -> usize {
         self.jobs

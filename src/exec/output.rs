@@ -21,7 +21,7 @@ fn read_bounded(path: &Path, limit: u64, what: &str) -> Result<Vec<u8>, String> 
         CappedRead::Io(e) => format!("cannot read {}: {e}", path.display()),
         CappedRead::Directory => format!("{} is a directory, not {what}", path.display()),
         CappedRead::TooLarge => format!(
-            "{} holds more than {limit} bytes, too many for {what}",
+            "{} holds more than {limit} bytes; expected a rendered image of at most that size",
             path.display()
         ),
     })

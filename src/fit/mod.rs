@@ -22,7 +22,7 @@ mod uncertainty;
 pub use checkpoint::Checkpoint;
 pub use config::{FitConfig, GenerationReport};
 pub use executor::{Observer, Problem};
-pub use output::{FitOutcome, FitResult, Population};
+pub use output::{Alternative, FitOutcome, FitResult, Population};
 pub use problem::render_seed;
 pub use target::FitTarget;
 pub use uncertainty::{Correlation, Uncertainty};
@@ -285,6 +285,12 @@ fn finish(
             .identifiability()
             .map(|id| uncertainty::of(&sub, &id)),
         shots: None,
+        alternatives: output::alternatives(
+            &sub,
+            &state.base,
+            search.best().0,
+            &search.alternatives(),
+        ),
     };
     result.check_finite()?;
     state.search = Some(search);

@@ -6,7 +6,8 @@ use crate::error::{Error, Result};
 use crate::metric::Deviation;
 use crate::raster::Image;
 use crate::rundir::{RunDir, BEST, FITTED_SCENE, RESULT};
-use crate::scene::Scene;
+use crate::scene::field::{Field, LightField, Value};
+use crate::scene::{ParamSpace, Scene};
 use serde::{Deserialize, Serialize};
 
 /// result.json. The binding keys come first; the rest are additions.
@@ -42,6 +43,79 @@ pub struct FitResult {
     /// deviation; `params` then holds the shared ones.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub shots: Option<Vec<ShotResult>>,
+    /// Other answers the search saw that fit alike the best, within the
+    /// noise of an 8-bit photograph (`optimize::basins`), best first;
+    /// absent when the answer is unambiguous.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub alternatives: Vec<Alternative>,
+}
+
+/// One entry of result.json's `alternatives`: another answer, in the
+/// scene's values as `params` gives them, and its average deviation in
+/// percent (as `deviation.average`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Alternative {
+    pub params: serde_json::Map<String, serde_json::Value>,
+    pub deviation: f64,
+}
+
+/// The search's alternatives (unit points and fitness, best first) as
+/// result.json's entries, keeping only those whose scene values differ
+/// from the best's by more than `optimize::basins::SEPARATION` of a
+/// parameter's range: a light's direction compared as a direction (its
+/// length changes nothing), a colour searched in HSV as RGB (a black
+/// ball's hue changes nothing).
+pub fn alternatives(
+    space: &ParamSpace,
+    base: &Scene,
+    best: &[f64],
+    found: &[(Vec<f64>, f64)],
+) -> Vec<Alternative> {
+    found
+        .iter()
+        .filter(|(u, _)| answer_distance(space, best, u) > crate::optimize::basins::SEPARATION)
+        .map(|(u, fitness)| Alternative {
+            params: space.json_values(&space.scene_at(base, u)),
+            // The fitness is the sum of the three channels' deviations.
+            deviation: fitness / 3.0,
+        })
+        .collect()
+}
+
+/// The largest difference between two unit points' scene values, each
+/// as a fraction of its parameter's range (see [`alternatives`]).
+fn answer_distance(space: &ParamSpace, a: &[f64], b: &[f64]) -> f64 {
+    let mut at = 0;
+    let mut largest: f64 = 0.0;
+    for spec in &space.specs {
+        let (ua, ub) = (&a[at..at + spec.dim()], &b[at..at + spec.dim()]);
+        at += spec.dim();
+        let d = match (spec.field, spec.value_at(ua), spec.value_at(ub)) {
+            (Field::Light(_, LightField::Direction), Value::Vector(x), Value::Vector(y)) => {
+                let (x, y) = (unit(x), unit(y));
+                (0..3).map(|c| (x[c] - y[c]).abs()).fold(0.0, f64::max) / 2.0
+            }
+            (_, Value::Vector(x), Value::Vector(y)) if spec.hsv => {
+                (0..3).map(|c| (x[c] - y[c]).abs()).fold(0.0, f64::max)
+            }
+            _ => ua
+                .iter()
+                .zip(ub)
+                .map(|(x, y)| (x - y).abs())
+                .fold(0.0, f64::max),
+        };
+        largest = largest.max(d);
+    }
+    largest
+}
+
+fn unit(v: [f64; 3]) -> [f64; 3] {
+    let n = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+    if n > 0.0 {
+        v.map(|c| c / n)
+    } else {
+        v
+    }
 }
 
 /// One photograph's part of result.json.

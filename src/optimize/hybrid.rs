@@ -45,6 +45,24 @@
 //! fitness is 0, or a local run gained nothing and the population has
 //! collapsed onto one point.
 //!
+//! **Restarts: a second opinion.** A population that has finished — its
+//! fitness is 0, it has collapsed, or both phases agree it is done (a
+//! local run from its best gained less than [`SETTLED_GAIN`] after a
+//! stint that also did not, the better half in one basin) — may have
+//! finished in the wrong basin: on a sharp landscape (a highlight of a few
+//! pixels, a thin shadow) the first population can close on a basin
+//! before any member has seen the true one, and a run that goes on from
+//! there only polishes it. So a fresh population is drawn over the whole
+//! cube (its own seed, derived from the run's), up to [`MAX_RESTARTS`]
+//! times, until two populations have ended alike the best fitness
+//! (`basins::alike`): the budget goes to evidence, not to a stall counter.
+//! The best point, the places seen ([`Basins`]) and the difference steps
+//! are kept; a population that then settles in a worse place gets the
+//! best point injected, so the run goes on from there as before. A run
+//! that reaches the executor's target ends first: on a smooth landscape
+//! the restarts cost nothing. Two populations that end alike in distinct
+//! places are what result.json's `alternatives` report.
+//!
 //! **Settling** ([`Hybrid::settle`], for refits that need an answer, not
 //! a budget spent): the run also ends once both phases agree they are done
 //! — a local run from the global best gained less than [`SETTLED_GAIN`],
@@ -60,6 +78,7 @@
 //! population follows it into its basin; a refit from scratch exists to
 //! find another basin (with the periodic trial, a diagnosis's refits of a
 //! light's falloff stopped at half the SAD drop SHADE alone reached).
+//! A settling run draws no fresh population.
 //!
 //! Everything is deterministic (the only random numbers are SHADE's, drawn
 //! from its seeded generator) and serialisable, floats bit-exact, so a run
@@ -67,6 +86,7 @@
 
 use serde::{Deserialize, Serialize};
 
+use super::basins::{alike, Basins};
 use super::identifiability::Identifiability;
 use super::lm::Normal;
 use super::local::Local;
@@ -93,6 +113,12 @@ pub const SETTLED_GAIN: f64 = 1e-3;
 /// A settling run ends once this many local runs in a row from other
 /// basins have not bettered the global best by [`SETTLED_GAIN`].
 pub const SETTLE_TRIES: usize = 2;
+/// Fresh populations drawn at most, one after another, to confirm where
+/// the first one ended (see the module docs).
+pub const MAX_RESTARTS: usize = 3;
+/// A restart's seed: the run's seed plus this times the restart's number,
+/// so that each population is independent and every run repeatable.
+const RESTART_SEED_STEP: u64 = 0x9E37_79B9_7F4A_7C15;
 /// Largest per-coordinate spread of a population collapsed onto one point.
 const COLLAPSED: f64 = 1e-12;
 
@@ -151,6 +177,17 @@ pub struct Hybrid {
     /// see [`Hybrid::set_periods`]); empty: none is periodic.
     #[serde(with = "exact::vector", default)]
     periods: Vec<f64>,
+    /// Distinct places that fit alike the best (result.json's
+    /// `alternatives`).
+    #[serde(default)]
+    basins: Basins,
+    /// The fitness each population ended at, one per population drawn so
+    /// far that has finished (see the module docs).
+    #[serde(with = "exact::vector", default)]
+    population_ends: Vec<f64>,
+    /// Local runs of earlier populations.
+    #[serde(default)]
+    earlier_local_runs: usize,
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -248,6 +285,9 @@ impl Hybrid {
             settle: false,
             fresh_tries: 0,
             periods: Vec::new(),
+            basins: Basins::default(),
+            population_ends: Vec::new(),
+            earlier_local_runs: 0,
         }
     }
 
@@ -281,7 +321,46 @@ impl Hybrid {
 
     /// Local runs started so far.
     pub fn local_runs(&self) -> usize {
-        self.starts.len()
+        self.earlier_local_runs + self.starts.len()
+    }
+
+    /// Populations drawn after the first (see the module docs).
+    pub fn restarts(&self) -> usize {
+        self.population_ends
+            .len()
+            .saturating_sub(1)
+            .min(MAX_RESTARTS)
+    }
+
+    /// Whether a finished population (ended at `fitness`) calls for a
+    /// fresh one: fewer than two populations have ended alike the best,
+    /// and the restarts are not used up.
+    fn restart_due(&mut self, fitness: f64) -> bool {
+        self.population_ends.push(fitness);
+        let agreeing = self
+            .population_ends
+            .iter()
+            .filter(|&&f| alike(self.best_fitness, f))
+            .count();
+        agreeing < 2 && self.population_ends.len() <= MAX_RESTARTS
+    }
+
+    /// Draws a fresh population over the whole cube; the best point, the
+    /// places seen and the difference steps stay.
+    fn restart(&mut self) {
+        let mut config = self.config.clone();
+        config.strategy = Strategy::Shade;
+        let n = self.population_ends.len() as u64;
+        config.seed = config.seed.wrapping_add(n.wrapping_mul(RESTART_SEED_STEP));
+        self.global = De::new(self.dim, config);
+        self.earlier_local_runs += self.starts.len();
+        self.starts.clear();
+        self.ends.clear();
+        self.local_end = f64::INFINITY;
+        self.outpaced = false;
+        self.stint_fitness = f64::INFINITY;
+        self.fresh_tries = 0;
+        self.phase = Phase::Global;
     }
 
     /// Standard errors and correlations at the best point, in unit
@@ -289,6 +368,12 @@ impl Hybrid {
     /// evaluated a Jacobian there (or if it is singular).
     pub fn identifiability(&self) -> Option<Identifiability> {
         Identifiability::from_normal(self.at_best.as_ref()?)
+    }
+
+    /// Other places seen that fit alike the best, in unit coordinates,
+    /// best first, with their fitness (see `basins.rs`).
+    pub fn alternatives(&self) -> Vec<(Vec<f64>, f64)> {
+        self.basins.alternatives(&self.best, self.best_fitness)
     }
 
     fn observe(&mut self, point: &[f64], fitness: f64) -> bool {
@@ -420,14 +505,27 @@ impl Hybrid {
         self.outpaced = local.outpaced && local.fitness <= self.local_end;
         self.local_end = self.local_end.min(local.fitness);
         self.ends.push(local.x.clone());
+        self.basins
+            .offer(&local.x, local.fitness, self.best_fitness);
         let gained = local.fitness < local.start_fitness;
         self.global.inject(&local.x, local.fitness);
         let stuck = !gained && collapsed(self.global.population(), self.global.fitness());
-        let settled = self.settle && local.global_done && !local.outpaced && {
+        let agreed = local.global_done && !local.outpaced && {
             let gain = 1.0 - local.fitness / local.start_fitness;
             let spreads = basin_spreads(self.global.population(), self.global.fitness());
             (gain.is_nan() || gain < SETTLED_GAIN) && found_basin(&spreads)
         };
+        let settled = self.settle && agreed;
+        let finished = local.fitness == 0.0 || stuck || agreed;
+        // A settling refit keeps its one population (see the module docs).
+        if finished && !self.settle && self.restart_due(local.fitness) {
+            self.restart();
+            return;
+        }
+        if agreed && !self.settle && !alike(self.best_fitness, local.fitness) {
+            // This population settled in a worse place: show it the best.
+            self.global.inject(&self.best.clone(), self.best_fitness);
+        }
         self.phase = if local.fitness == 0.0 || stuck || settled {
             Phase::Done
         } else {
@@ -463,6 +561,7 @@ impl Hybrid {
             && self.steps.len() == dim
             && (self.periods.is_empty() || self.periods.len() == dim)
             && self.starts.iter().chain(&self.ends).all(|s| s.len() == dim)
+            && self.basins.fits(dim)
             && self.at_best.as_ref().is_none_or(normal_ok);
         if let Phase::Local(local) = &self.phase {
             ok &= local.fits(dim) && local.normal.as_ref().is_none_or(normal_ok);

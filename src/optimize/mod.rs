@@ -28,6 +28,7 @@
 //!   ([`Identifiability`]). The executor builds any of them through
 //!   [`Searcher::new`].
 
+pub mod basins;
 mod config;
 mod de;
 pub(crate) mod exact;

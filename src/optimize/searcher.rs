@@ -1,6 +1,7 @@
 //! [`Searcher`]: any search strategy as one serialisable value, so that a
 //! checkpoint stores whichever one a run uses, and where a search starts.
 
+use super::basins::Basins;
 use super::{
     De, DeConfig, Evaluation, Hybrid, Identifiability, Progress, Request, Search, Strategy,
 };
@@ -46,6 +47,24 @@ impl Searcher {
         match config.strategy {
             Strategy::Hybrid => Searcher::Hybrid(Hybrid::new(global, config)),
             _ => Searcher::De(global),
+        }
+    }
+
+    /// Other places the search saw that fit alike its best, in unit
+    /// coordinates, best first, with their fitness (`basins.rs`): what
+    /// the hybrid saw over its run, or a population search's final
+    /// population.
+    pub fn alternatives(&self) -> Vec<(Vec<f64>, f64)> {
+        match self {
+            Searcher::De(de) => {
+                let (best, best_fitness) = de.best();
+                let mut basins = Basins::default();
+                for (point, &f) in de.population().iter().zip(de.fitness()) {
+                    basins.offer(point, f, best_fitness);
+                }
+                basins.alternatives(best, best_fitness)
+            }
+            Searcher::Hybrid(h) => h.alternatives(),
         }
     }
 

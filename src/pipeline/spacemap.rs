@@ -543,6 +543,7 @@ fn finish(
         identifiability: None,
         deviation_precise: None,
         shots: None,
+        alternatives: Vec::new(),
     };
     result.check_finite()?;
     dir.write_json(FITTED_SCENE, &scene)?;
@@ -568,6 +569,17 @@ mod tests {
         Image::from_raw(v.len() as u32 / 3, 1, v.to_vec()).unwrap()
     }
 
+    /// `image` as a fit's target, made in memory.
+    fn target_of(image: &Image) -> FitTarget {
+        FitTarget {
+            levels: None,
+            image: image.clone(),
+            mask: None,
+            path: None,
+            encoding: None,
+        }
+    }
+
     #[test]
     fn corrected_target_subtracts_the_fine_coarse_gap_and_clamps() {
         let t = img(&[100, 5, 250, 0, 0, 0]);
@@ -585,13 +597,7 @@ mod tests {
         let t = img(&[100, 50, 200, 10, 20, 30]);
         let f = img(&[90, 60, 190, 15, 20, 35]);
         let c = img(&[10, 200, 0, 255, 0, 7]);
-        let target = FitTarget {
-            levels: None,
-            image: t.clone(),
-            mask: None,
-            path: None,
-            encoding: None,
-        };
+        let target = target_of(&t);
         let s = surrogate_deviation(&target, &c, &f, &c);
         assert_eq!(s, deviation(&t, &f, None));
     }
@@ -603,13 +609,7 @@ mod tests {
         let t = img(&[10, 250, 128, 0, 255, 3]);
         let f = img(&[60, 200, 128, 30, 200, 3]);
         let ck = img(&[10, 255, 100, 0, 255, 0]);
-        let target = FitTarget {
-            levels: None,
-            image: t.clone(),
-            mask: None,
-            path: None,
-            encoding: None,
-        };
+        let target = target_of(&t);
         let corrected = corrected_target(&t, &f, &ck);
         let gaps: Vec<f64> = [[0u8; 6], [255; 6], [7, 99, 200, 13, 0, 255]]
             .iter()

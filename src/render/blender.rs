@@ -15,12 +15,12 @@
 //! are the built-in tracer's and unused here.
 
 use super::backend::Backend;
+use super::external::{started, Process};
 use super::worker_start::PythonWorker;
-use super::{RenderSession, Renderer};
+use super::RenderSession;
 use crate::error::Result;
 use crate::exec::discover;
 use crate::exec::process::CommandSpec;
-use crate::scene::{ParamSpace, Scene};
 use std::time::Duration;
 
 /// The registry's entry (`registry::ALL`).
@@ -46,17 +46,12 @@ const WORKER: PythonWorker = PythonWorker {
 /// The Blender backend, with the caller's process options.
 pub struct Blender(pub super::RenderOptions);
 
-impl Renderer for Blender {
+impl Process for Blender {
     fn name(&self) -> String {
         "blender".into()
     }
 
-    fn session(
-        &self,
-        _base: &Scene,
-        _varying: &ParamSpace,
-        jobs: usize,
-    ) -> Result<Box<dyn RenderSession>> {
+    fn start(&self, jobs: usize) -> Result<Box<dyn RenderSession>> {
         let program = discover::find("blender", &discover::apt_hint("blender"))?;
         let command = |dir: &std::path::Path, script| {
             CommandSpec::new(program)
@@ -76,9 +71,6 @@ impl Renderer for Blender {
                 .arg(script)
                 .args(["--", "--threads", "1"])
         };
-        match WORKER.start(jobs, &self.0, command) {
-            Ok(s) => Ok(Box::new(s)),
-            Err((e, _)) => Err(e),
-        }
+        started(WORKER.start(jobs, &self.0, command))
     }
 }

@@ -17,31 +17,20 @@
 //! is (a camera that stores linear values).
 //! A scene without these fields passes through untouched.
 
+use super::layer::{Layer, Prepared};
 #[cfg(test)]
 use super::srgb::encode;
 use super::srgb::{decode, encode_exact};
-use super::{Image, RenderResult, RenderSession, Renderer};
-use crate::error::Result;
+use super::Image;
 use crate::scene::{Camera, ParamSpace, Response, ResponseEncoding, Scene};
+use std::borrow::Cow;
 
-/// Any renderer, followed by the camera's image-space effects.
-pub struct WithCameraEffects(pub Box<dyn Renderer>);
+/// The layer that applies the camera's image-space effects after any backend.
+#[derive(Clone, Copy, Debug)]
+pub struct CameraEffects;
 
-impl Renderer for WithCameraEffects {
-    fn name(&self) -> String {
-        self.0.name()
-    }
-
-    fn default_jobs(&self) -> usize {
-        self.0.default_jobs()
-    }
-
-    fn session(
-        &self,
-        base: &Scene,
-        varying: &ParamSpace,
-        jobs: usize,
-    ) -> Result<Box<dyn RenderSession>> {
+impl Layer for CameraEffects {
+    fn prepare<'a>(&self, base: &'a Scene, varying: &'a ParamSpace) -> Prepared<'a> {
         // The backend never sees the image-space fields vary: they do not
         // change what it renders.
         let inner_space = ParamSpace {
@@ -52,29 +41,11 @@ impl Renderer for WithCameraEffects {
                 .cloned()
                 .collect(),
         };
-        Ok(Box::new(CameraEffectsSession {
-            inner: self.0.session(base, &inner_space, jobs)?,
-        }))
-    }
-}
-
-struct CameraEffectsSession {
-    inner: Box<dyn RenderSession>,
-}
-
-impl RenderSession for CameraEffectsSession {
-    fn describe(&self) -> String {
-        self.inner.describe()
+        Ok((Cow::Borrowed(base), Cow::Owned(inner_space)))
     }
 
-    fn render_batch(&mut self, scenes: &[Scene], seed: u64) -> Vec<RenderResult> {
-        let mut out = self.inner.render_batch(scenes, seed);
-        for (res, scene) in out.iter_mut().zip(scenes) {
-            if let Ok(img) = res {
-                apply(&scene.camera, img);
-            }
-        }
-        out
+    fn after(&self, scene: &Scene, image: &mut Image) {
+        apply(&scene.camera, image);
     }
 }
 
@@ -186,21 +157,12 @@ fn powered(b: f64, gamma: f64) -> [f64; 256] {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scene::{CameraKind, Response, Vignetting};
+    use crate::scene::{Response, Vignetting};
 
     fn camera() -> Camera {
-        Camera {
-            kind: CameraKind::Perspective,
-            position: [0.0, 0.0, 5.0],
-            look_at: [0.0; 3],
-            up: [0.0, 1.0, 0.0],
-            fov_y_deg: Some(40.0),
-            height: None,
-            vignetting: None,
-            response: None,
-            exposure: None,
-            white_balance: None,
-        }
+        serde_json::from_value(serde_json::json!({"type": "perspective",
+            "position": [0.0, 0.0, 5.0], "look_at": [0.0, 0.0, 0.0], "fov_y_deg": 40.0}))
+        .unwrap()
     }
 
     #[test]

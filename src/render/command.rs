@@ -12,13 +12,13 @@
 //! command work as typed. Every scene field is passed through unchanged.
 
 use super::backend::Backend;
-use super::external::{session_dir, ExternalSession, OneShotBackend};
-use super::{RenderOptions, RenderSession, Renderer};
+use super::external::{session_dir, started, ExternalSession, Files, OneShotBackend, Process};
+use super::{RenderOptions, RenderSession};
 use crate::error::{Error, Result};
 use crate::exec::discover;
 use crate::exec::process::CommandSpec;
-use crate::scene::{ParamSpace, Scene};
-use std::path::{Path, PathBuf};
+use crate::scene::Scene;
+use std::path::PathBuf;
 use std::time::Duration;
 
 /// The registry's entry for `cmd:TEMPLATE`: every field is passed on.
@@ -109,17 +109,12 @@ fn words(spec: &str, what: &str) -> Result<(PathBuf, Vec<String>)> {
     Ok((path, rest.to_vec()))
 }
 
-impl Renderer for Command {
+impl Process for Command {
     fn name(&self) -> String {
         format!("{}{}", self.prefix(), self.text)
     }
 
-    fn session(
-        &self,
-        _base: &Scene,
-        _varying: &ParamSpace,
-        jobs: usize,
-    ) -> Result<Box<dyn RenderSession>> {
+    fn start(&self, jobs: usize) -> Result<Box<dyn RenderSession>> {
         let (program, mut args) = words(&self.text, self.prefix())?;
         if self.kind == Kind::OneShot {
             args = template_args(&self.text, args)?;
@@ -137,10 +132,7 @@ impl Renderer for Command {
             }
             Kind::Worker => {
                 let spec = CommandSpec::new(program).args(args);
-                match ExternalSession::persistent(&self.name(), spec, cfg, dir) {
-                    Ok(s) => Ok(Box::new(s)),
-                    Err((e, _)) => Err(e),
-                }
+                started(ExternalSession::persistent(&self.name(), spec, cfg, dir))
             }
         }
     }
@@ -168,19 +160,18 @@ struct Template {
 }
 
 impl OneShotBackend for Template {
-    fn prepare(
-        &self,
-        dir: &Path,
-        id: u64,
-        scene: &Scene,
-        seed: u64,
-    ) -> std::result::Result<(CommandSpec, PathBuf), String> {
-        let scene_path = dir.join(format!("r{id}.json"));
-        let output = dir.join(format!("r{id}.png"));
-        let text = serde_json::to_string_pretty(&super::external::plain_scene(scene))
-            .map_err(|e| format!("cannot write the scene: {e}"))?;
-        std::fs::write(&scene_path, text)
-            .map_err(|e| format!("cannot write {}: {e}", scene_path.display()))?;
+    fn extension(&self) -> &'static str {
+        "json"
+    }
+
+    fn scene_text(&self, scene: &Scene) -> std::result::Result<String, String> {
+        serde_json::to_string_pretty(&super::external::plain_scene(scene))
+            .map_err(|e| format!("cannot write the scene: {e}"))
+    }
+
+    fn command(&self, files: &Files, _scene: &Scene, seed: u64) -> CommandSpec {
+        let scene_path = files.dir.join(&files.scene);
+        let output = files.dir.join(&files.image);
         let (sp, op, sd) = (
             scene_path.to_string_lossy(),
             output.to_string_lossy(),
@@ -191,6 +182,6 @@ impl OneShotBackend for Template {
                 .replace("{output}", &op)
                 .replace("{seed}", &sd)
         });
-        Ok((CommandSpec::new(&self.program).args(args), output))
+        CommandSpec::new(&self.program).args(args)
     }
 }

@@ -4,30 +4,100 @@
 //! persistent workers (`crate::exec`). Renders that fail cost their
 //! candidate only; the processes are killed when the session is dropped.
 
-use super::{RenderFailure, RenderOptions, RenderResult, RenderSession};
+use super::{RenderFailure, RenderOptions, RenderResult, RenderSession, Renderer};
 use crate::error::{Error, Result};
 use crate::exec::oneshot::{self, OneShotJob};
 use crate::exec::pool::{WorkerJob, WorkerPool};
 use crate::exec::process::CommandSpec;
 use crate::exec::{self, ExecConfig};
-use crate::scene::Scene;
-use std::path::{Path, PathBuf};
+use crate::scene::{ParamSpace, Scene};
+use std::path::Path;
 use std::time::Duration;
 use tempfile::TempDir;
 use tokio::runtime::Runtime;
 
-/// A one-shot renderer: how one render is set up.
+/// A renderer whose renders run in other processes. Each render reads its
+/// scene whole, so starting a session needs only how many renders run at
+/// once: the base scene and what varies are the in-process tracer's
+/// concern. Every such backend is a [`Renderer`] through this.
+pub trait Process: Send + Sync {
+    /// The name given on the command line.
+    fn name(&self) -> String;
+
+    /// Renders at once by default; None: the number of cores.
+    fn default_jobs(&self) -> Option<usize> {
+        None
+    }
+
+    /// Starts the processes (or prepares to) for up to `jobs` renders at once.
+    fn start(&self, jobs: usize) -> Result<Box<dyn RenderSession>>;
+}
+
+impl<P: Process> Renderer for P {
+    fn name(&self) -> String {
+        Process::name(self)
+    }
+
+    fn default_jobs(&self) -> usize {
+        Process::default_jobs(self)
+            .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()))
+    }
+
+    fn session(&self, _: &Scene, _: &ParamSpace, jobs: usize) -> Result<Box<dyn RenderSession>> {
+        self.start(jobs)
+    }
+}
+
+/// A pool's start-up result as a session: the start-up failure's error
+/// (its stderr already in the message).
+pub fn started<S: RenderSession + 'static>(
+    r: std::result::Result<S, (Error, RenderFailure)>,
+) -> Result<Box<dyn RenderSession>> {
+    match r {
+        Ok(s) => Ok(Box::new(s)),
+        Err((e, _)) => Err(e),
+    }
+}
+
+/// A one-shot renderer: how one render is set up. The session writes the
+/// scene file and names the files, the same way for every backend.
 pub trait OneShotBackend: Send {
-    /// Writes what the renderer reads for render `id` of `scene` into `dir`
-    /// and returns the command that renders it and the image it writes.
-    /// An Err fails that render (the scene cannot be expressed).
-    fn prepare(
-        &self,
-        dir: &Path,
+    /// The scene file's extension, e.g. `pov`.
+    fn extension(&self) -> &'static str;
+
+    /// The scene file's text for `scene`; an Err fails that render (the
+    /// scene cannot be expressed).
+    fn scene_text(&self, scene: &Scene) -> std::result::Result<String, String>;
+
+    /// The command that renders `files.scene` into `files.image`.
+    fn command(&self, files: &Files, scene: &Scene, seed: u64) -> CommandSpec;
+}
+
+/// One render's files: names inside the run's directory `dir`.
+pub struct Files<'a> {
+    pub dir: &'a Path,
+    pub scene: String,
+    pub image: String,
+}
+
+impl Files<'_> {
+    /// Writes render `id`'s scene file for `backend` into `dir`.
+    fn write<'a>(
+        dir: &'a Path,
         id: u64,
+        backend: &dyn OneShotBackend,
         scene: &Scene,
-        seed: u64,
-    ) -> std::result::Result<(CommandSpec, PathBuf), String>;
+    ) -> std::result::Result<Files<'a>, String> {
+        let text = backend.scene_text(scene)?;
+        let files = Files {
+            dir,
+            scene: format!("r{id}.{}", backend.extension()),
+            image: format!("r{id}.png"),
+        };
+        let path = dir.join(&files.scene);
+        std::fs::write(&path, text).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+        Ok(files)
+    }
 }
 
 enum Mode {
@@ -169,11 +239,11 @@ impl RenderSession for ExternalSession {
                 let mut jobs = Vec::new();
                 let mut slots = Vec::new();
                 for (i, (scene, id)) in scenes.iter().zip(&ids).enumerate() {
-                    match backend.prepare(&dir, *id, scene, seed) {
-                        Ok((command, output)) => {
+                    match Files::write(&dir, *id, backend.as_ref(), scene) {
+                        Ok(files) => {
                             jobs.push(OneShotJob {
-                                command,
-                                output,
+                                command: backend.command(&files, scene, seed),
+                                output: dir.join(&files.image),
                                 width: scene.image.width,
                                 height: scene.image.height,
                             });
@@ -191,7 +261,7 @@ impl RenderSession for ExternalSession {
                 for (i, r) in slots.into_iter().zip(rendered) {
                     results[i] = Some(r);
                 }
-                cleanup_inputs(&dir, &ids);
+                cleanup_inputs(&dir, &ids, backend.extension());
             }
             Mode::Persistent(pool) => {
                 let jobs: Vec<WorkerJob> = scenes
@@ -228,9 +298,9 @@ impl RenderSession for ExternalSession {
 }
 
 /// Removes the per-render input files (`r{id}.*`) a one-shot backend wrote.
-fn cleanup_inputs(dir: &Path, ids: &[u64]) {
+fn cleanup_inputs(dir: &Path, ids: &[u64], scene_extension: &str) {
     for id in ids {
-        for ext in ["pov", "json", "png"] {
+        for ext in [scene_extension, "png"] {
             let _ = std::fs::remove_file(dir.join(format!("r{id}.{ext}")));
         }
     }

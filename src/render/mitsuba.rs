@@ -15,12 +15,12 @@
 //! `render.antialias` and `render.max_depth` are unused here.
 
 use super::backend::Backend;
+use super::external::Process;
 use super::worker_start::PythonWorker;
-use super::{RenderSession, Renderer};
+use super::RenderSession;
 use crate::error::{Error, Result};
 use crate::exec::discover;
 use crate::exec::process::CommandSpec;
-use crate::scene::{ParamSpace, Scene};
 use std::time::Duration;
 
 /// The registry's entry (`registry::ALL`).
@@ -52,17 +52,12 @@ const INSTALL: &str = "install it with `python3 -m pip install mitsuba` (and `ap
 /// The Mitsuba backend, with the caller's process options.
 pub struct Mitsuba(pub super::RenderOptions);
 
-impl Renderer for Mitsuba {
+impl Process for Mitsuba {
     fn name(&self) -> String {
         "mitsuba".into()
     }
 
-    fn session(
-        &self,
-        _base: &Scene,
-        _varying: &ParamSpace,
-        jobs: usize,
-    ) -> Result<Box<dyn RenderSession>> {
+    fn start(&self, jobs: usize) -> Result<Box<dyn RenderSession>> {
         let python = match &self.0.python {
             Some(p) => p.to_string_lossy().into_owned(),
             None => "python3".into(),

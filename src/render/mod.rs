@@ -12,6 +12,7 @@ pub mod backend;
 pub mod blender;
 pub mod command;
 pub mod external;
+pub mod layer;
 pub mod mitsuba;
 pub mod near_lights;
 pub mod pbr_fields;

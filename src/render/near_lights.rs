@@ -13,53 +13,25 @@
 //! sizes away: across the object its direction turns and its irradiance
 //! falls off, which a directional light cannot show.
 
-use super::{RenderResult, RenderSession, Renderer};
-use crate::error::Result;
+use super::layer::{Layer, Prepared};
 use crate::scene::{Falloff, LightKind, ParamSpace, Scene};
 use std::borrow::Cow;
 
-/// Any renderer, drawing near lights as point lights.
-pub struct WithNearLights(pub Box<dyn Renderer>);
+/// The layer that draws near lights as point lights, before any backend.
+#[derive(Clone, Copy, Debug)]
+pub struct NearLights;
 
-impl Renderer for WithNearLights {
-    fn name(&self) -> String {
-        self.0.name()
-    }
-
-    fn default_jobs(&self) -> usize {
-        self.0.default_jobs()
-    }
-
-    fn session(
-        &self,
-        base: &Scene,
-        varying: &ParamSpace,
-        jobs: usize,
-    ) -> Result<Box<dyn RenderSession>> {
+impl Layer for NearLights {
+    fn prepare<'a>(&self, base: &'a Scene, varying: &'a ParamSpace) -> Prepared<'a> {
         // `varying` still names the direction and distance of a lowered
         // light: the built-in tracer then treats it as a light that turns,
         // which is what it is.
-        Ok(Box::new(NearLightsSession {
-            inner: self.0.session(&lower(base), varying, jobs)?,
-        }))
-    }
-}
-
-struct NearLightsSession {
-    inner: Box<dyn RenderSession>,
-}
-
-impl RenderSession for NearLightsSession {
-    fn describe(&self) -> String {
-        self.inner.describe()
+        Ok((lower(base), Cow::Borrowed(varying)))
     }
 
-    fn render_batch(&mut self, scenes: &[Scene], seed: u64) -> Vec<RenderResult> {
-        if !scenes.iter().any(has_near_lights) {
-            return self.inner.render_batch(scenes, seed);
-        }
-        let lowered: Vec<Scene> = scenes.iter().map(|s| lower(s).into_owned()).collect();
-        self.inner.render_batch(&lowered, seed)
+    fn before(&self, scenes: &[Scene]) -> Option<Vec<Scene>> {
+        let near = scenes.iter().any(has_near_lights);
+        near.then(|| scenes.iter().map(|s| lower(s).into_owned()).collect())
     }
 }
 

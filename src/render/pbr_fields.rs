@@ -5,8 +5,8 @@
 //! Blinn-Phong lobes, `fresnel`, `specular2`) and any `falloff_power`
 //! (docs/renderers.md, "One material convention").
 //!
-//! Refused: an object's `transform` (the workers do not place shapes
-//! yet), a Mitsuba area light (`radius` > 0: a shape with an area
+//! Refused: a pinhole camera's `distortion` (also by POV-Ray) and, by
+//! Mitsuba, its `fy` other than `fx` (non-square pixels), a Mitsuba area light (`radius` > 0: a shape with an area
 //! emitter) with a falloff other than 1/d^2, and `fresnel` or `specular2` on a
 //! transmitting material (glass is drawn by the principled BSDF, with its
 //! own Fresnel term and one lobe), `albedo_map` (a map in the image's
@@ -15,7 +15,7 @@
 //! tracer's stand-in for what `render.indirect` traces: not refused.
 
 use super::backend::Refusal;
-use crate::scene::{Falloff, LightKind, Scene};
+use crate::scene::{CameraKind, Falloff, LightKind, Scene};
 
 /// What the Blender worker cannot draw (`registry::Backend::supports`).
 pub fn blender(scene: &Scene) -> Vec<Refusal> {
@@ -27,10 +27,31 @@ pub fn mitsuba(scene: &Scene) -> Vec<Refusal> {
     refusals(scene, true)
 }
 
+/// A pinhole camera's lens distortion, which the built-in tracer alone
+/// draws (the others' cameras have no distortion model); `backend` names
+/// the one refusing. None for no distortion, or all coefficients 0.
+pub fn distortion(scene: &Scene, backend: &str) -> Option<Refusal> {
+    let d = scene.camera.distortion?;
+    (d != [0.0; 5]).then(|| {
+        Refusal::new(
+            "camera.distortion",
+            format!("lens distortion is drawn by phong only ({backend}'s camera has no distortion model); use phong, or undistort the photograph (OpenCV's undistort) and drop distortion"),
+        )
+    })
+}
+
 /// Every field either worker cannot draw; `mitsuba` adds what only
 /// Mitsuba cannot (area lights are shapes there).
 fn refusals(scene: &Scene, mitsuba: bool) -> Vec<Refusal> {
-    let mut out = Vec::new();
+    let name = if mitsuba { "mitsuba" } else { "blender" };
+    let mut out: Vec<Refusal> = distortion(scene, name).into_iter().collect();
+    let c = &scene.camera;
+    if mitsuba && c.kind == CameraKind::Pinhole && c.fx != c.fy {
+        out.push(Refusal::new(
+            "camera.fy",
+            "Mitsuba's perspective camera has square pixels (its to_world may not scale); give fy the value of fx, or use phong, povray or blender",
+        ));
+    }
     let mut refuse = |field: String, why: &str| out.push(Refusal::new(field, why));
     for l in &scene.lights {
         if !mitsuba || l.radius <= 0.0 || l.kind != LightKind::Point {
@@ -48,10 +69,16 @@ fn refusals(scene: &Scene, mitsuba: bool) -> Vec<Refusal> {
         }
     }
     for o in &scene.objects {
-        if o.transform.is_some() {
+        // Mitsuba's mesh loaders place the file's vertices once; moving
+        // them per candidate (as a box's are) is not written yet.
+        let posed = o
+            .transform
+            .as_ref()
+            .is_some_and(|t| *t != Default::default());
+        if mitsuba && posed && matches!(o.shape, crate::scene::Shape::Mesh { .. }) {
             refuse(
                 format!("objects.{}.transform", o.name),
-                "a placed object is drawn by phong only so far; use phong, or write the shape where it is",
+                "a mesh with a transform is drawn by phong, povray and blender; apply the transform to the file, or use one of those",
             );
         }
         let m = &o.material;
@@ -103,21 +130,6 @@ mod tests {
                 refused[0].field.ends_with("material.diffuse_f90"),
                 "{refused:?}"
             );
-        }
-    }
-
-    #[test]
-    fn a_transform_is_refused_by_every_other_backend_naming_the_field() {
-        let mut scene = crate::scene::test_scene::ball(r#""color": [0.5, 0.5, 0.5]"#, "");
-        let pov = crate::render::pov_sdl::refusals;
-        assert!(blender(&scene).is_empty() && mitsuba(&scene).is_empty() && pov(&scene).is_empty());
-        scene.objects[0].transform = Some(crate::scene::Transform {
-            translate: Some([0.0, 0.1, 0.0]),
-            ..Default::default()
-        });
-        for refused in [blender(&scene), mitsuba(&scene), pov(&scene)] {
-            assert_eq!(refused.len(), 1, "{refused:?}");
-            assert_eq!(refused[0].field, "objects.ball.transform", "{refused:?}");
         }
     }
 }

@@ -7,7 +7,10 @@
 //!   which keeps the image the same with POV-Ray's left-handed camera.
 //! - `camera`: perspective (`angle` = horizontal field of view computed from
 //!   `fov_y_deg` and the aspect ratio) or orthographic (`up` = height, `right`
-//!   = height * aspect); `position`, `look_at`, `up` (as `sky`).
+//!   = height * aspect); `position`, `look_at`, `up` (as `sky`); `pinhole`:
+//!   a perspective camera with its own `direction`, `right` and `up`
+//!   built from fx, fy, cx, cy (see `pinhole_camera`); its `distortion` is
+//!   refused.
 //! - `ambient` A: `global_settings { ambient_light A }` and finish
 //!   `ambient kd` (unoccluded, as in Phong).
 //! - `render.max_depth` m: `max_trace_level` m + 1 (POV-Ray counts the camera ray).
@@ -22,10 +25,12 @@
 //!   oriented `area_light` of diameter 2r (9x9). `directional` -> a
 //!   `parallel` light 1e6 m away along `direction`, colour E*color.
 //! - objects: `sphere`, `plane`, `quad` (`polygon`), `box`, `mesh`
-//!   (`mesh2`, with `normal_vectors` when the file has vertex normals).
+//!   (`mesh2`, with `normal_vectors` when the file has vertex normals); an
+//!   object's `transform` after the shape as `scale`, `rotate`, `translate`
+//!   (see `placement`).
 //! - names: never written (comments say `lights[i]`, `objects[i]`): the
 //!   SDL holds only numbers and fixed keywords, whatever a scene contains.
-//! - refused (a clear error): an object's `transform`, a directional light's `radius`, a material's
+//! - refused (a clear error): a directional light's `radius`, a material's
 //!   `fresnel` (other than 1), `diffuse_f90` (other than 1), `specular2` on glass, `albedo_map`. `indirect_light` (the
 //!   built-in tracer's estimate) is not used: `render.indirect` is POV-Ray's.
 //! - material (kd, ks, n, kr, kt, ior; T = min(kt, MAX_TRANSMIT)):
@@ -40,7 +45,9 @@
 //!   bottom finish).
 
 use super::backend::Refusal;
-use crate::scene::{CameraKind, Falloff, LightKind, Material, Scene, Shape, Vec3};
+use crate::math::V3;
+use crate::scene::pinhole::Pinhole;
+use crate::scene::{CameraKind, Falloff, LightKind, Material, Scene, Shape, Transform, Vec3};
 use std::f64::consts::PI;
 use std::fmt::Write;
 
@@ -106,13 +113,10 @@ pub fn refusals(scene: &Scene) -> Vec<Refusal> {
             ));
         }
     }
+    if let Some(r) = super::pbr_fields::distortion(scene, "povray") {
+        out.push(r);
+    }
     for o in &scene.objects {
-        if o.transform.is_some() {
-            out.push(Refusal::new(
-                format!("objects.{}.transform", o.name),
-                "a placed object is drawn by phong only so far; use phong, or write the shape where it is",
-            ));
-        }
         let m = &o.material;
         if m.albedo_map.is_some() {
             out.push(Refusal::new(
@@ -230,8 +234,9 @@ pub fn sdl(scene: &Scene) -> Result<String, String> {
         // names are never written: the SDL holds only numbers and keywords
         let _ = writeln!(
             s,
-            "// objects[{i}]\n{shape}\n  {}\n}}",
-            material(&o.material)
+            "// objects[{i}]\n{shape}\n  {}{}\n}}",
+            material(&o.material),
+            o.transform.as_ref().map_or(String::new(), placement)
         );
     }
     Ok(s)
@@ -282,31 +287,67 @@ const RADIOSITY: &str = "\n  radiosity { pretrace_start 0.08 pretrace_end 0.01 c
 
 fn camera(s: &mut String, scene: &Scene) {
     let c = &scene.camera;
-    let aspect = scene.image.width as f64 / scene.image.height as f64;
-    let common = format!("location {} sky {}", vec(pov(c.position)), vec(pov(c.up)));
-    match c.kind {
-        CameraKind::Perspective => {
-            let fov_y = c.fov_y_deg.unwrap_or(40.0).to_radians();
-            let fov_x = 2.0 * ((fov_y / 2.0).tan() * aspect).atan();
-            let _ = writeln!(
-                s,
-                "camera {{ perspective {common} right x*{} up y angle {} look_at {} }}",
-                num(aspect),
-                num(fov_x.to_degrees()),
-                vec(pov(c.look_at))
-            );
-        }
-        CameraKind::Orthographic => {
-            let h = c.height.unwrap_or(1.0);
-            let _ = writeln!(
-                s,
-                "camera {{ orthographic {common} right x*{} up y*{} look_at {} }}",
-                num(h * aspect),
-                num(h),
-                vec(pov(c.look_at))
-            );
-        }
+    if let Some(p) = Pinhole::of(c) {
+        let _ = writeln!(s, "{}", pinhole_camera(&p, scene.image));
+        return;
     }
+    let aspect = scene.image.width as f64 / scene.image.height as f64;
+    let common = format!("location {} sky {}", vec(pov(c.eye())), vec(pov(c.up)));
+    let look_at = vec(pov(c.target()));
+    if c.kind == CameraKind::Orthographic {
+        let h = c.height.unwrap_or(1.0);
+        let _ = writeln!(
+            s,
+            "camera {{ orthographic {common} right x*{} up y*{} look_at {look_at} }}",
+            num(h * aspect),
+            num(h),
+        );
+    } else {
+        let fov_y = c.fov_y_deg.unwrap_or(40.0).to_radians();
+        let fov_x = 2.0 * ((fov_y / 2.0).tan() * aspect).atan();
+        let _ = writeln!(
+            s,
+            "camera {{ perspective {common} right x*{} up y angle {} look_at {look_at} }}",
+            num(aspect),
+            num(fov_x.to_degrees()),
+        );
+    }
+}
+
+/// A calibrated pinhole (without distortion, which is refused) as POV-Ray's
+/// perspective camera with its own vectors: its ray through the screen
+/// point (sx, sy), each in [-0.5, 0.5] from the left and the bottom, is
+/// `direction + sx right + sy up`. The pixel whose centre is at sx, sy has
+/// OpenCV coordinates u = (sx + 1/2) W - 1/2, v = (1/2 - sy) H - 1/2, seen
+/// along ((u - cx)/fx, (v - cy)/fy, 1) in the camera's frame: so right =
+/// (W/fx, 0, 0), up = (0, -H/fy, 0) and direction = ((W/2 - 1/2 - cx)/fx,
+/// (H/2 - 1/2 - cy)/fy, 1), each carried into the world and mirrored.
+fn pinhole_camera(p: &Pinhole, size: crate::scene::ImageSize) -> String {
+    let (w, h) = (size.width as f64, size.height as f64);
+    let (fx, fy, cx, cy) = p.intrinsics();
+    let world = |v: [f64; 3]| vec(pov(p.camera_to_world(V3::from(v)).to_array()));
+    format!(
+        "camera {{ perspective location {} direction {} right {} up {} }}",
+        vec(pov(p.centre().to_array())),
+        world([(w / 2.0 - 0.5 - cx) / fx, (h / 2.0 - 0.5 - cy) / fy, 1.0]),
+        world([w / fx, 0.0, 0.0]),
+        world([0.0, -h / fy, 0.0]),
+    )
+}
+
+/// An object's transform after its shape: `scale`, `rotate` (POV-Ray
+/// turns about x, then y, then z, as the scene does) and `translate`. The
+/// mirrored z turns a rotation about x or y the other way: P Rx(a) P =
+/// Rx(-a) with P = diag(1, 1, -1), while Rz and the scale are unchanged.
+fn placement(t: &Transform) -> String {
+    let sc = t.scale.map_or([1.0; 3], |k| k.axes());
+    let [rx, ry, rz] = t.rotate_deg.unwrap_or_default();
+    format!(
+        "\n  scale {} rotate {} translate {}",
+        vec(sc),
+        vec([-rx, -ry, rz]),
+        vec(pov(t.translate.unwrap_or_default()))
+    )
 }
 
 fn light(s: &mut String, i: usize, l: &crate::scene::Light) -> Result<(), String> {

@@ -10,12 +10,12 @@
 //! sampler seed are unused: POV-Ray is deterministic.
 
 use super::backend::Backend;
-use super::external::{session_dir, ExternalSession, OneShotBackend};
-use super::{pov_sdl, RenderSession, Renderer};
+use super::external::{session_dir, ExternalSession, Files, OneShotBackend, Process};
+use super::{pov_sdl, RenderSession};
 use crate::error::{Error, Result};
 use crate::exec::discover;
 use crate::exec::process::CommandSpec;
-use crate::scene::{ParamSpace, Scene};
+use crate::scene::Scene;
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
@@ -40,21 +40,16 @@ pub const DEFAULT_JOBS: usize = 128;
 /// The POV-Ray backend, with the caller's process options.
 pub struct PovRay(pub super::RenderOptions);
 
-impl Renderer for PovRay {
+impl Process for PovRay {
     fn name(&self) -> String {
         "povray".into()
     }
 
-    fn default_jobs(&self) -> usize {
-        DEFAULT_JOBS
+    fn default_jobs(&self) -> Option<usize> {
+        Some(DEFAULT_JOBS)
     }
 
-    fn session(
-        &self,
-        _base: &Scene,
-        _varying: &ParamSpace,
-        jobs: usize,
-    ) -> Result<Box<dyn RenderSession>> {
+    fn start(&self, jobs: usize) -> Result<Box<dyn RenderSession>> {
         let program = discover::find("povray", &discover::apt_hint("povray"))?;
         let (cfg, dir) = session_dir(jobs, (RENDER_TIMEOUT, RENDER_TIMEOUT), &self.0)?;
         let version = version(&program);
@@ -74,24 +69,21 @@ struct PovBackend {
 }
 
 impl OneShotBackend for PovBackend {
-    fn prepare(
-        &self,
-        dir: &Path,
-        id: u64,
-        scene: &Scene,
-        _seed: u64,
-    ) -> std::result::Result<(CommandSpec, PathBuf), String> {
+    fn extension(&self) -> &'static str {
+        "pov"
+    }
+
+    fn scene_text(&self, scene: &Scene) -> std::result::Result<String, String> {
         let text = pov_sdl::sdl(scene)?;
         only_version_directive(&text)?;
-        let input = format!("r{id}.pov");
-        let output = format!("r{id}.png");
-        std::fs::write(dir.join(&input), text)
-            .map_err(|e| format!("cannot write {}: {e}", dir.join(&input).display()))?;
-        let spec = CommandSpec::new(&self.program)
-            .cwd(dir)
-            .env("HOME", dir) // reads the povray.conf of `confine`, not the user's
-            .args(arguments(scene, &input, &output));
-        Ok((spec, dir.join(output)))
+        Ok(text)
+    }
+
+    fn command(&self, files: &Files, scene: &Scene, _seed: u64) -> CommandSpec {
+        CommandSpec::new(&self.program)
+            .cwd(files.dir)
+            .env("HOME", files.dir) // reads the povray.conf of `confine`, not the user's
+            .args(arguments(scene, &files.scene, &files.image))
     }
 }
 

@@ -48,11 +48,24 @@ fn scene_for(field: &str) -> Scene {
         "`render.max_depth` above 254" => s.render.max_depth = 255,
         "`material.diffuse_f90` (other than 1)" => m.diffuse_f90 = Some(0.5),
         "`material.albedo_map`" => m.albedo_map = Some("map.png".into()),
-        "`objects[].transform`" => {
-            s.objects[0].transform = Some(crate::scene::Transform {
-                translate: Some([0.0, 0.1, 0.0]),
-                ..Default::default()
-            })
+        "`camera.fy` other than `camera.fx` (a pinhole's)" => {
+            s.camera = serde_json::from_value(serde_json::json!({"type": "pinhole",
+                "fx": 100.0, "fy": 90.0, "cx": 31.5, "cy": 23.5, "rotation": [0.0, 0.0, 0.0],
+                "translation": [0.0, -0.5, 5.0]}))
+            .unwrap()
+        }
+        "`camera.distortion` (a pinhole's, not all 0)" => {
+            s.camera = serde_json::from_value(serde_json::json!({"type": "pinhole",
+                "fx": 100.0, "fy": 100.0, "cx": 31.5, "cy": 23.5, "rotation": [0.0, 0.0, 0.0],
+                "translation": [0.0, -0.5, 5.0], "distortion": [-0.1, 0.0, 0.0, 0.0, 0.0]}))
+            .unwrap()
+        }
+        "`transform` of a `mesh` object" => {
+            s.objects[0].shape = crate::scene::Shape::Mesh {
+                file: "m.ply".into(),
+            };
+            s.objects[0].transform =
+                serde_json::from_value(serde_json::json!({"translate": [0.1, 0.0, 0.0]})).unwrap();
         }
         other => panic!("docs/renderers.md refuses {other:?}: add a scene for it here"),
     }

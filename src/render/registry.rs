@@ -6,9 +6,13 @@
 //! (`cmd:`, `worker:`) are entries whose name is a prefix.
 
 pub use super::backend::{Backend, Refusal};
-use super::{phong, RenderOptions, RenderSession, Renderer};
+use super::camera_effects::CameraEffects;
+use super::layer::{Layer, Layered, Prepared};
+use super::near_lights::NearLights;
+use super::{phong, RenderOptions, Renderer};
 use crate::error::{Error, Result};
 use crate::scene::{ParamSpace, Scene};
+use std::borrow::Cow;
 
 /// The built-in tracer: draws every field (it is the model).
 const PHONG: Backend = Backend {
@@ -51,33 +55,20 @@ pub fn find(spec: &str) -> Result<(&'static Backend, &str)> {
 /// scene with a field it cannot draw.
 pub fn build(spec: &str, opts: &RenderOptions) -> Result<Box<dyn Renderer>> {
     let (entry, rest) = find(spec)?;
-    Ok(Box::new(Checked {
-        entry,
-        inner: (entry.build)(rest, opts.clone()),
-    }))
+    let inner = (entry.build)(rest, opts.clone());
+    let name = inner.name();
+    Ok(Box::new(Layered::new(Checked { entry, name }, inner)))
 }
 
-/// A backend behind its `supports` check.
+/// A backend's `supports` check, as a layer over it.
+#[derive(Clone)]
 struct Checked {
     entry: &'static Backend,
-    inner: Box<dyn Renderer>,
+    name: String,
 }
 
-impl Renderer for Checked {
-    fn name(&self) -> String {
-        self.inner.name()
-    }
-
-    fn default_jobs(&self) -> usize {
-        self.inner.default_jobs()
-    }
-
-    fn session(
-        &self,
-        base: &Scene,
-        varying: &ParamSpace,
-        jobs: usize,
-    ) -> Result<Box<dyn RenderSession>> {
+impl Layer for Checked {
+    fn prepare<'a>(&self, base: &'a Scene, varying: &'a ParamSpace) -> Prepared<'a> {
         let refused = (self.entry.supports)(base);
         if let Some(first) = refused.first() {
             // one line: the first field in full, the others by name
@@ -89,12 +80,10 @@ impl Renderer for Checked {
             };
             return Err(Error::Usage(format!(
                 "{}: {}: {}{also}",
-                self.inner.name(),
-                first.field,
-                first.why
+                self.name, first.field, first.why
             )));
         }
-        self.inner.session(base, varying, jobs)
+        Ok((Cow::Borrowed(base), Cow::Borrowed(varying)))
     }
 }
 
@@ -106,10 +95,8 @@ pub fn from_spec(spec: &str) -> Result<Box<dyn Renderer>> {
 
 /// `from_spec` with the caller's options over the defaults.
 pub fn from_spec_with(spec: &str, opts: &RenderOptions) -> Result<Box<dyn Renderer>> {
-    let drawn = super::near_lights::WithNearLights(build(spec, opts)?);
-    Ok(Box::new(super::camera_effects::WithCameraEffects(
-        Box::new(drawn),
-    )))
+    let drawn = Layered::new(NearLights, build(spec, opts)?);
+    Ok(Box::new(Layered::new(CameraEffects, Box::new(drawn))))
 }
 
 #[cfg(test)]

@@ -204,6 +204,7 @@ mod tests {
             failed_renders: 0,
             identifiability: None,
             shots: None,
+            alternatives: Vec::new(),
         };
         let c = read_progress(&p, &result).unwrap();
         assert_eq!(c.len(), 2);

@@ -10,6 +10,7 @@
 //! (%R %G %B average), the fitted parameters side by side, time and
 //! renders per stage, and the parameter trade-offs.
 
+mod alternatives;
 pub mod data;
 mod figure;
 pub mod font;

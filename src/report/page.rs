@@ -30,6 +30,7 @@ pub fn render(run: &Run) -> Result<String> {
     table_i(&mut page, run);
     heatmaps(&mut page, run)?;
     parameters(&mut page, run);
+    super::alternatives::section(&mut page, run);
     cost(&mut page, run);
     convergence(&mut page, run)?;
     evolution(&mut page, run)?;

@@ -3,11 +3,18 @@
 //! resolved once against a scene into a `Field`, which then reads and writes
 //! that value in any copy of the scene without string matching.
 //!
+//! A pinhole camera's `camera.fx|fy|cx|cy|rotation|translation` and
+//! `camera.distortion.k1|k2|p1|p2|k3` (when it has `distortion`).
+//!
+//! An object's `objects.NAME.transform.translate|rotate_deg|scale` always
+//! resolves: an absent transform is the identity, written when first set.
+//!
 //! The optional effect fields (`indirect_light`, `lights.NAME.falloff_power|distance`,
 //! `objects.NAME.material.fresnel|specular2|shininess2|diffuse_f90`,
 //! `camera.vignetting.strength`, `camera.response.gain|gamma|black`) resolve
 //! only when the scene has them: set them first, then free them.
 
+use super::transform::{Scale, Transform};
 use super::types::{Scene, Vec3};
 
 /// A resolved numeric field of a scene.
@@ -20,6 +27,15 @@ pub enum Field {
     /// A shape's numeric field, by its name in the shape (`Shape::fields`).
     Shape(usize, &'static str),
     Camera(CameraField),
+    /// An object's `transform.translate|rotate_deg|scale` (absent: identity).
+    Transform(usize, TransformField),
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TransformField {
+    Translate,
+    RotateDeg,
+    Scale,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -61,7 +77,19 @@ pub enum CameraField {
     ResponseBlack,
     Exposure,
     WhiteBalance,
+    /// A pinhole camera's calibration (scene/pinhole.rs).
+    Fx,
+    Fy,
+    Cx,
+    Cy,
+    Rotation,
+    Translation,
+    /// `camera.distortion.k1|k2|p1|p2|k3`: coefficient i of the five.
+    Distortion(usize),
 }
+
+/// The names of a pinhole camera's distortion coefficients, in order.
+pub const DISTORTION_KEYS: [&str; 5] = ["k1", "k2", "p1", "p2", "k3"];
 
 /// A field's value: a number or a 3-vector.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -95,9 +123,10 @@ impl Field {
             ["lights", name, field] => light_field(scene, name, field, path),
             ["objects", name, "material", field] => material_field(scene, name, field, path),
             ["objects", name, "shape", field] => shape_field(scene, name, field),
+            ["objects", name, "transform", field] => transform_field(scene, name, field),
             ["camera", field] => camera_field(scene, field),
             ["camera", group, field] => camera_group_field(scene, group, field, path),
-            _ => Err("expected ambient, indirect_light, lights.NAME.FIELD, objects.NAME.material.FIELD, objects.NAME.shape.FIELD or camera.FIELD".into()),
+            _ => Err("expected ambient, indirect_light, lights.NAME.FIELD, objects.NAME.material.FIELD, objects.NAME.shape.FIELD, objects.NAME.transform.FIELD or camera.FIELD".into()),
         }
     }
 
@@ -143,8 +172,8 @@ impl Field {
             Field::Camera(f) => {
                 let c = &scene.camera;
                 match f {
-                    CameraField::Position => Vector(c.position),
-                    CameraField::LookAt => Vector(c.look_at),
+                    CameraField::Position => Vector(c.position?),
+                    CameraField::LookAt => Vector(c.look_at?),
                     CameraField::Up => Vector(c.up),
                     CameraField::FovY => Scalar(c.fov_y_deg?),
                     CameraField::Height => Scalar(c.height?),
@@ -154,8 +183,16 @@ impl Field {
                     CameraField::ResponseBlack => Scalar(c.response?.black),
                     CameraField::Exposure => Scalar(c.exposure?),
                     CameraField::WhiteBalance => Vector(c.white_balance?),
+                    CameraField::Fx => Scalar(c.fx?),
+                    CameraField::Fy => Scalar(c.fy?),
+                    CameraField::Cx => Scalar(c.cx?),
+                    CameraField::Cy => Scalar(c.cy?),
+                    CameraField::Rotation => Vector(c.rotation?),
+                    CameraField::Translation => Vector(c.translation?),
+                    CameraField::Distortion(k) => Scalar(c.distortion?[k]),
                 }
             }
+            Field::Transform(i, f) => transform_value(&scene.objects[i].transform, f),
         })
     }
 
@@ -169,6 +206,7 @@ impl Field {
             Field::Material(i, f) => set_material(&mut scene.objects[i].material, f, value),
             Field::Shape(i, f) => set_shape(&mut scene.objects[i].shape, f, value),
             Field::Camera(f) => set_camera(&mut scene.camera, f, value),
+            Field::Transform(i, f) => set_transform(&mut scene.objects[i].transform, f, value),
         }
     }
 
@@ -185,6 +223,9 @@ impl Field {
             }
             Field::Shape(i, f) => format!("objects.{}.shape.{f}", scene.objects[i].name),
             Field::Camera(f) => format!("camera.{}", f.key()),
+            Field::Transform(i, f) => {
+                format!("objects.{}.transform.{}", scene.objects[i].name, f.key())
+            }
         }
     }
 
@@ -210,7 +251,15 @@ impl Field {
                     | CameraField::Up
                     | CameraField::FovY
                     | CameraField::Height
+                    | CameraField::Fx
+                    | CameraField::Fy
+                    | CameraField::Cx
+                    | CameraField::Cy
+                    | CameraField::Rotation
+                    | CameraField::Translation
+                    | CameraField::Distortion(_)
             ) | Field::Shape(..)
+                | Field::Transform(..)
                 | Field::Material(_, MaterialField::Ior)
         )
     }
@@ -264,6 +313,16 @@ impl MaterialField {
     }
 }
 
+impl TransformField {
+    fn key(self) -> &'static str {
+        match self {
+            TransformField::Translate => "translate",
+            TransformField::RotateDeg => "rotate_deg",
+            TransformField::Scale => "scale",
+        }
+    }
+}
+
 impl CameraField {
     fn key(self) -> &'static str {
         match self {
@@ -278,6 +337,17 @@ impl CameraField {
             CameraField::ResponseBlack => "response.black",
             CameraField::Exposure => "exposure",
             CameraField::WhiteBalance => "white_balance",
+            CameraField::Fx => "fx",
+            CameraField::Fy => "fy",
+            CameraField::Cx => "cx",
+            CameraField::Cy => "cy",
+            CameraField::Rotation => "rotation",
+            CameraField::Translation => "translation",
+            CameraField::Distortion(0) => "distortion.k1",
+            CameraField::Distortion(1) => "distortion.k2",
+            CameraField::Distortion(2) => "distortion.p1",
+            CameraField::Distortion(3) => "distortion.p2",
+            CameraField::Distortion(_) => "distortion.k3",
         }
     }
 }
@@ -361,6 +431,51 @@ fn shape_field(scene: &Scene, name: &str, field: &str) -> Result<Field, String> 
     }
 }
 
+/// `objects.NAME.transform.FIELD`: resolves whether or not the object has
+/// a transform (absent keys are the identity, written when first set).
+fn transform_field(scene: &Scene, name: &str, field: &str) -> Result<Field, String> {
+    let i = object(scene, name)?;
+    let f = match field {
+        "translate" => TransformField::Translate,
+        "rotate_deg" => TransformField::RotateDeg,
+        "scale" => TransformField::Scale,
+        other => {
+            return Err(format!(
+                "a transform has no field \"{other}\" (expected translate, rotate_deg or scale)"
+            ))
+        }
+    };
+    Ok(Field::Transform(i, f))
+}
+
+/// A transform's value; an absent one is the identity's. A scale is a
+/// number unless the scene gives one per axis.
+fn transform_value(t: &Option<Transform>, f: TransformField) -> Value {
+    let t = t.as_ref();
+    match f {
+        TransformField::Translate => Value::Vector(t.and_then(|t| t.translate).unwrap_or_default()),
+        TransformField::RotateDeg => {
+            Value::Vector(t.and_then(|t| t.rotate_deg).unwrap_or_default())
+        }
+        TransformField::Scale => match t.and_then(|t| t.scale) {
+            Some(Scale::Axes(v)) => Value::Vector(v),
+            Some(Scale::Uniform(x)) => Value::Scalar(x),
+            None => Value::Scalar(1.0),
+        },
+    }
+}
+
+fn set_transform(t: &mut Option<Transform>, f: TransformField, value: Value) {
+    let t = t.get_or_insert_with(Transform::default);
+    match (f, value) {
+        (TransformField::Translate, Value::Vector(v)) => t.translate = Some(v),
+        (TransformField::RotateDeg, Value::Vector(v)) => t.rotate_deg = Some(v),
+        (TransformField::Scale, Value::Vector(v)) => t.scale = Some(Scale::Axes(v)),
+        (TransformField::Scale, Value::Scalar(x)) => t.scale = Some(Scale::Uniform(x)),
+        _ => {}
+    }
+}
+
 /// `camera.FIELD`, when the camera model has it.
 fn camera_field(scene: &Scene, key: &str) -> Result<Field, String> {
     let f = match key {
@@ -371,6 +486,12 @@ fn camera_field(scene: &Scene, key: &str) -> Result<Field, String> {
         "height" => CameraField::Height,
         "exposure" => CameraField::Exposure,
         "white_balance" => CameraField::WhiteBalance,
+        "fx" => CameraField::Fx,
+        "fy" => CameraField::Fy,
+        "cx" => CameraField::Cx,
+        "cy" => CameraField::Cy,
+        "rotation" => CameraField::Rotation,
+        "translation" => CameraField::Translation,
         other => return Err(format!("the camera has no numeric field \"{other}\"")),
     };
     let resolved = Field::Camera(f);
@@ -392,9 +513,12 @@ fn camera_group_field(
         ("response", "gain") => CameraField::ResponseGain,
         ("response", "gamma") => CameraField::ResponseGamma,
         ("response", "black") => CameraField::ResponseBlack,
+        ("distortion", k) if DISTORTION_KEYS.contains(&k) => {
+            CameraField::Distortion(DISTORTION_KEYS.iter().position(|x| *x == k).unwrap_or(0))
+        }
         _ => {
             return Err(
-                "expected camera.vignetting.strength or camera.response.gain|gamma|black".into(),
+                "expected camera.vignetting.strength, camera.response.gain|gamma|black or camera.distortion.k1|k2|p1|p2|k3".into(),
             )
         }
     };
@@ -462,8 +586,8 @@ fn set_shape(sh: &mut super::types::Shape, name: &str, value: Value) {
 
 fn set_camera(c: &mut super::types::Camera, f: CameraField, value: Value) {
     match f {
-        CameraField::Position => v(&mut c.position, value),
-        CameraField::LookAt => v(&mut c.look_at, value),
+        CameraField::Position => ov(&mut c.position, value),
+        CameraField::LookAt => ov(&mut c.look_at, value),
         CameraField::Up => v(&mut c.up, value),
         CameraField::FovY => os(&mut c.fov_y_deg, value),
         CameraField::Height => os(&mut c.height, value),
@@ -489,6 +613,17 @@ fn set_camera(c: &mut super::types::Camera, f: CameraField, value: Value) {
         }
         CameraField::Exposure => os(&mut c.exposure, value),
         CameraField::WhiteBalance => ov(&mut c.white_balance, value),
+        CameraField::Fx => os(&mut c.fx, value),
+        CameraField::Fy => os(&mut c.fy, value),
+        CameraField::Cx => os(&mut c.cx, value),
+        CameraField::Cy => os(&mut c.cy, value),
+        CameraField::Rotation => ov(&mut c.rotation, value),
+        CameraField::Translation => ov(&mut c.translation, value),
+        CameraField::Distortion(k) => {
+            if let (Some(d), Value::Scalar(x)) = (c.distortion.as_mut(), value) {
+                d[k] = x;
+            }
+        }
     }
 }
 

@@ -101,14 +101,18 @@ pub fn check_fit(
     );
     // What fits of one share with the others as they are.
     let fits = |share: f64, each: f64| ((avail - (need - share)) / each).floor().max(0.0);
-    if renders > population && renders > image {
-        let (option, most) = (pop.jobs_option(), fits(renders, px * PER_PIXEL_JOB));
+    // Lowering an option helps only if the smallest value it can take
+    // fits; otherwise the image itself is what must shrink.
+    let most_jobs = fits(renders, px * PER_PIXEL_JOB);
+    if renders > population && renders > image && most_jobs >= 1.0 {
+        let (option, most) = (pop.jobs_option(), most_jobs);
         return Err(Error::Usage(format!(
             "{option} {jobs}: {jobs} renders at once of {width}x{height} pixels {needs}; expected {option} up to {most}"
         )));
     }
-    if population >= image {
-        let most = (fits(population, per_individual) / copies as f64).floor();
+    let most_population = (fits(population, per_individual) / copies as f64).floor();
+    if population >= image && most_population >= crate::optimize::MIN_POPULATION as f64 {
+        let most = most_population;
         let each = if copies > 1 {
             format!(" ({copies} images of each candidate at once)")
         } else {
@@ -212,6 +216,17 @@ mod tests {
     fn the_largest_image_names_the_scene_key() {
         let e = refusal(16384, 16384, 10);
         assert!(e.starts_with("s.json: image.width:"), "{e}");
+    }
+
+    /// An image so large that even the smallest population does not fit
+    /// is blamed on the image, never answered with "a population up to 0".
+    #[test]
+    fn an_image_too_large_for_any_population_names_the_scene_key() {
+        let e = check_fit(Some(18.0 * GIB), "s.json", (16384, 16384), pop(80), 2)
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("s.json: image.width:"), "{e}");
+        assert!(!e.contains("up to 0"), "{e}");
     }
 
     #[test]

@@ -12,6 +12,7 @@ pub mod memory;
 pub mod mesh;
 pub mod nuisance;
 pub mod params;
+pub mod pinhole;
 pub mod shape;
 #[cfg(test)]
 pub(crate) mod test_scene;

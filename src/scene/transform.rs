@@ -2,7 +2,8 @@
 //! "rotate_deg": [rx, ry, rz], "scale": s or [sx, sy, sz]}` on any object,
 //! each key optional. A point of the shape is scaled first, then rotated
 //! about the world x, then y, then z axis (right-handed, degrees), then
-//! translated. The built-in tracer draws it; other backends refuse it.
+//! translated. Every backend draws it; each key is a free parameter
+//! (`objects.NAME.transform.translate|rotate_deg|scale`, scene/field.rs).
 
 use crate::math::Vec3;
 use crate::math::V3;
@@ -216,6 +217,28 @@ mod tests {
             e.contains("objects[0].transform") && e.contains("unknown field"),
             "{e}"
         );
+    }
+
+    /// A transform's keys resolve as free fields on an object without one
+    /// (the identity's values), and writing one creates the transform.
+    #[test]
+    fn transform_keys_are_fields_even_before_the_object_has_one() {
+        use crate::scene::field::{Field, Value};
+        let mut scene = crate::scene::test_scene::ball(r#""color": [0.5, 0.5, 0.5]"#, "");
+        assert!(scene.objects[0].transform.is_none());
+        let turn = Field::resolve(&scene, "objects.ball.transform.rotate_deg").unwrap();
+        let scale = Field::resolve(&scene, "objects.ball.transform.scale").unwrap();
+        assert_eq!(turn.get(&scene), Some(Value::Vector([0.0; 3])));
+        assert_eq!(scale.get(&scene), Some(Value::Scalar(1.0)));
+        assert!(turn.moves_geometry() && scale.moves_geometry());
+        turn.set(&mut scene, Value::Vector([0.0, 30.0, 0.0]));
+        scale.set(&mut scene, Value::Scalar(2.0));
+        let t = scene.objects[0].transform.as_ref().unwrap();
+        assert_eq!(t.rotate_deg, Some([0.0, 30.0, 0.0]));
+        assert_eq!(t.scale, Some(Scale::Uniform(2.0)));
+        assert_eq!(turn.path(&scene), "objects.ball.transform.rotate_deg");
+        let e = Field::resolve(&scene, "objects.ball.transform.turn").unwrap_err();
+        assert!(e.contains("translate, rotate_deg or scale"), "{e}");
     }
 
     #[test]

@@ -44,23 +44,51 @@ pub struct ImageSize {
 pub enum CameraKind {
     Perspective,
     Orthographic,
+    /// A calibrated camera in OpenCV's conventions (scene/pinhole.rs).
+    Pinhole,
 }
 
-/// One struct for both camera kinds; `validate` checks that each kind has
-/// its own fields and none of the other's.
+/// One struct for every camera kind; `validate` checks that each kind has
+/// its own fields and none of the others'. `perspective` and
+/// `orthographic` are placed by `position`, `look_at` and `up`; `pinhole`
+/// by `rotation` and `translation` (world to camera), with `fx`, `fy`,
+/// `cx`, `cy` in pixels and optional `distortion`.
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct Camera {
     #[serde(rename = "type")]
     pub kind: CameraKind,
-    pub position: Vec3,
-    pub look_at: Vec3,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub position: Option<Vec3>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub look_at: Option<Vec3>,
+    /// Not used by a pinhole camera (its rotation orients it), which then
+    /// takes only the default.
     #[serde(default = "default_up")]
     pub up: Vec3,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub fov_y_deg: Option<f64>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub height: Option<f64>,
+    /// A pinhole camera's calibration, as OpenCV's `calibrateCamera` /
+    /// `solvePnP` return it (scene/pinhole.rs); absent for the other kinds.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fx: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fy: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cx: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cy: Option<f64>,
+    /// Rodrigues vector of the world-to-camera rotation (`rvec`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rotation: Option<Vec3>,
+    /// World-to-camera translation (`tvec`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub translation: Option<Vec3>,
+    /// k1, k2, p1, p2, k3 (absent: none).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub distortion: Option<[f64; 5]>,
     /// Image-space darkening towards the corners (absent: none).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub vignetting: Option<Vignetting>,

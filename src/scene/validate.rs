@@ -4,7 +4,7 @@
 //! names the key path and what was expected.
 
 use super::checks::{finite3, non_negative, non_negative3, nonzero3, positive};
-use super::field::{Field, Value};
+use super::field::{Field, TransformField, Value};
 use super::limits::*;
 use super::types::*;
 use crate::error::{Error, Result};
@@ -189,30 +189,11 @@ fn forbidden<T>(file: &str, key: &str, v: &Option<T>, what: &str) -> Result<()> 
 }
 
 fn camera(c: &Camera, file: &str) -> Result<()> {
-    if !finite3(c.position) || !finite3(c.look_at) {
-        return Err(Error::invalid(
-            file,
-            "camera.position",
-            "expected finite numbers",
-        ));
+    if c.kind == CameraKind::Pinhole {
+        return super::pinhole::check(c, file);
     }
-    let view = V3::from(c.look_at) - V3::from(c.position);
-    if view.length() < 1e-9 {
-        return Err(Error::invalid(
-            file,
-            "camera.look_at",
-            "must differ from camera.position",
-        ));
-    }
-    nonzero3(file, "camera.up", c.up)?;
-    let up = V3::from(c.up).normalized();
-    if view.normalized().cross(up).length() < 1e-6 {
-        return Err(Error::invalid(
-            file,
-            "camera.up",
-            "is parallel to the view direction (look_at - position); expected a vector that is not",
-        ));
-    }
+    super::pinhole::forbid_in_other_kinds(c, file)?;
+    placement(c, file)?;
     match c.kind {
         CameraKind::Perspective => {
             let fov = required(
@@ -235,6 +216,8 @@ fn camera(c: &Camera, file: &str) -> Result<()> {
                 "a perspective camera (use fov_y_deg)",
             )
         }
+        // its own check, above
+        CameraKind::Pinhole => Ok(()),
         CameraKind::Orthographic => {
             let h = required(
                 file,
@@ -251,6 +234,48 @@ fn camera(c: &Camera, file: &str) -> Result<()> {
             )
         }
     }
+}
+
+/// A look-at camera's `position`, `look_at` and `up`: present, finite, and
+/// not degenerate.
+fn placement(c: &Camera, file: &str) -> Result<()> {
+    let position = required(
+        file,
+        "camera.position",
+        c.position,
+        "a perspective or orthographic camera needs position and look_at",
+    )?;
+    let look_at = required(
+        file,
+        "camera.look_at",
+        c.look_at,
+        "a perspective or orthographic camera needs position and look_at",
+    )?;
+    if !finite3(position) || !finite3(look_at) {
+        return Err(Error::invalid(
+            file,
+            "camera.position",
+            "expected finite numbers",
+        ));
+    }
+    let view = V3::from(look_at) - V3::from(position);
+    if view.length() < 1e-9 {
+        return Err(Error::invalid(
+            file,
+            "camera.look_at",
+            "must differ from camera.position",
+        ));
+    }
+    nonzero3(file, "camera.up", c.up)?;
+    let up = V3::from(c.up).normalized();
+    if view.normalized().cross(up).length() < 1e-6 {
+        return Err(Error::invalid(
+            file,
+            "camera.up",
+            "is parallel to the view direction (look_at - position); expected a vector that is not",
+        ));
+    }
+    Ok(())
 }
 
 /// The optional effect fields of the scene and camera.
@@ -444,6 +469,13 @@ fn free(scene: &Scene, f: &FreeParam, file: &str, at: &str) -> Result<()> {
     if let Value::Scalar(_) = current {
         physical_minimum(&field, f, lo[0], file, at)?;
     }
+    if matches!(field, Field::Transform(_, TransformField::Scale)) && lo.iter().any(|&x| x <= 0.0) {
+        return Err(Error::invalid(
+            file,
+            format!("{at}.min"),
+            format!("\"{}\" cannot go below or to 0", f.param),
+        ));
+    }
     Ok(())
 }
 
@@ -550,8 +582,17 @@ fn physical_minimum(field: &Field, f: &FreeParam, lo: f64, file: &str, at: &str)
             | super::field::CameraField::Exposure,
         )
         | Field::Shape(..) => f64::MIN_POSITIVE,
-        // A black level below 0 is one subtracted (clipped at 0).
-        Field::Camera(super::field::CameraField::ResponseBlack) => f64::NEG_INFINITY,
+        Field::Camera(super::field::CameraField::Fx | super::field::CameraField::Fy) => {
+            f64::MIN_POSITIVE
+        }
+        // A black level below 0 is one subtracted (clipped at 0); a
+        // principal point or a distortion coefficient may be negative.
+        Field::Camera(
+            super::field::CameraField::ResponseBlack
+            | super::field::CameraField::Cx
+            | super::field::CameraField::Cy
+            | super::field::CameraField::Distortion(_),
+        ) => f64::NEG_INFINITY,
         _ => 0.0,
     };
     if lo < physical_min {

@@ -36,3 +36,5 @@ pub fn json(path: &Path) -> serde_json::Value {
     )
     .unwrap()
 }
+
+pub mod traps;

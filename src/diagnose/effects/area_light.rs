@@ -30,7 +30,7 @@ impl Effect for AreaLight {
         let l = &scene.lights[i];
         let max = match l.kind {
             LightKind::Point => {
-                0.5 * (V3::from(l.position?) - V3::from(scene.camera.look_at)).length()
+                0.5 * (V3::from(l.position?) - V3::from(scene.camera.target())).length()
             }
             LightKind::Directional => 0.3,
         };

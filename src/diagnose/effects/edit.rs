@@ -53,7 +53,7 @@ pub fn glossy(scene: &Scene) -> Vec<usize> {
 
 /// A rough size of the scene: the distance from the camera to what it looks at.
 pub fn scale(scene: &Scene) -> f64 {
-    (V3::from(scene.camera.position) - V3::from(scene.camera.look_at)).length()
+    (V3::from(scene.camera.eye()) - V3::from(scene.camera.target())).length()
 }
 
 /// Which fitted parameters join the search of a new effect's own. Light
@@ -141,7 +141,7 @@ pub const DISTANCES: [f64; 5] = [0.55, 0.7, 0.85, 1.0, 1.2];
 /// there.
 pub fn closer(scene: &Scene, scale: f64) -> Scene {
     let mut s = scene.clone();
-    let look = V3::from(scene.camera.look_at);
+    let look = V3::from(scene.camera.target());
     for (i, l) in s.lights.iter_mut().enumerate() {
         let Some(p) = l.position else { continue };
         let Some(f) = free_entry(scene, Field::Light(i, LightField::Position)) else {

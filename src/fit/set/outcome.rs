@@ -77,6 +77,7 @@ pub fn finish(
         failed_renders: state.failed_renders,
         identifiability: None,
         shots: Some(outs.iter().map(|o| o.result.clone()).collect()),
+        alternatives: Vec::new(),
     };
     result.check_finite()?;
     let outcome = SetOutcome {

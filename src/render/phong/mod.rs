@@ -49,8 +49,11 @@ impl Renderer for Phong {
         varying: &ParamSpace,
         jobs: usize,
     ) -> Result<Box<dyn RenderSession>> {
+        // The tracer is CPU-bound: threads beyond the cores only cost (a
+        // huge --jobs once started 50,000 threads and stalled the machine).
+        // The result does not depend on the thread count.
         let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(jobs.max(1))
+            .num_threads(jobs.clamp(1, self.default_jobs()))
             .build()
             .map_err(|e| Error::Run(format!("phong: cannot start threads: {e}")))?;
         let variation = Variation::new(base, varying);
@@ -79,6 +82,7 @@ struct Prepared {
 impl Prepared {
     fn new(scene: &Scene, variation: &Variation, parallel: bool) -> Prepared {
         let paths = Paths::build(scene, variation, parallel);
+        // A cancelled build is empty (paths.rs): packing it costs nothing.
         let packed = Packed::new(&paths, scene.lights.len());
         Prepared { paths, packed }
     }
@@ -112,6 +116,10 @@ impl PhongSession {
             Some(p) => shade::shade(&p.paths, &p.packed, scene, &maps, &mut buf),
             None => {
                 let p = Prepared::new(scene, &self.variation, false);
+                // a cancelled build is cut short, never shaded
+                if cancel::is_cancelled() {
+                    return Err(RenderFailure::new(cancel::MESSAGE));
+                }
                 shade::shade(&p.paths, &p.packed, scene, &maps, &mut buf)
             }
         }

@@ -7,7 +7,7 @@
 
 use super::bounce::Bounce;
 use super::geometry::Occluder;
-use super::paths::{Paths, Shadow, NO_PARENT};
+use super::paths::{Paths, Shadow, Vertex, NO_PARENT};
 
 /// A run of hits on one object.
 pub struct Group {
@@ -28,6 +28,46 @@ pub struct LightPack {
     pub qc: Vec<f32>,
     /// (packed index, trace index) of hits tested the general way.
     pub complex: Vec<(u32, u32)>,
+}
+
+impl LightPack {
+    /// The shadowing by light `l` of the hits in packed `order`.
+    fn of(paths: &Paths, order: &[u32], lights: usize, l: usize) -> LightPack {
+        let n = order.len();
+        let mut p = LightPack {
+            vis: vec![1.0; n],
+            qx: vec![0.0; n],
+            qy: vec![0.0; n],
+            qz: vec![0.0; n],
+            qc: vec![f32::INFINITY; n],
+            complex: Vec::new(),
+        };
+        for (k, &i) in order.iter().enumerate() {
+            match paths.shadow[i as usize * lights + l] {
+                Shadow::Lit => {}
+                Shadow::Dark => p.vis[k] = 0.0,
+                Shadow::Test { start, len } => {
+                    let occ = &paths.occluders[start as usize..(start + len) as usize];
+                    match occ {
+                        [Occluder::Cone {
+                            axis,
+                            cos_max,
+                            center_dist,
+                            ..
+                        }] => {
+                            let q = *axis * *center_dist;
+                            p.qx[k] = q.x as f32;
+                            p.qy[k] = q.y as f32;
+                            p.qz[k] = q.z as f32;
+                            p.qc[k] = (center_dist * center_dist * cos_max * cos_max) as f32;
+                        }
+                        _ => p.complex.push((k as u32, i)),
+                    }
+                }
+            }
+        }
+        p
+    }
 }
 
 pub struct Packed {
@@ -56,10 +96,24 @@ pub struct Packed {
 }
 
 impl Packed {
+    ///
+    /// On Ctrl-C it stops between passes and returns no hits at all: on a
+    /// large image packing takes seconds, and a cancelled render is never
+    /// shaded (mod.rs).
     pub fn new(paths: &Paths, lights: usize) -> Packed {
-        let n = paths.verts.len();
+        let all = paths.verts.len();
+        Packed::pack(paths, lights, all, crate::exec::cancel::is_cancelled)
+            .or_else(|| Packed::pack(paths, lights, 0, || false))
+            .expect("an empty packing is never cut short")
+    }
+
+    /// Packs the first `n` hits of `paths`; None once `cancelled` says so.
+    fn pack(paths: &Paths, lights: usize, n: usize, cancelled: fn() -> bool) -> Option<Packed> {
         let mut order: Vec<u32> = (0..n as u32).collect();
         order.sort_by_key(|&i| paths.verts[i as usize].object); // stable: keeps trace order within an object
+        if cancelled() {
+            return None;
+        }
         let mut packed_of = vec![0u32; n];
         for (k, &i) in order.iter().enumerate() {
             packed_of[i as usize] = k as u32;
@@ -76,65 +130,53 @@ impl Packed {
                 }),
             }
         }
-        let col = |f: &dyn Fn(usize) -> f64| -> Vec<f32> {
-            order.iter().map(|&i| f(i as usize) as f32).collect()
-        };
         let v = &paths.verts;
         let mut packs = Vec::with_capacity(lights);
         for l in 0..lights {
-            let mut p = LightPack {
-                vis: vec![1.0; n],
-                qx: vec![0.0; n],
-                qy: vec![0.0; n],
-                qz: vec![0.0; n],
-                qc: vec![f32::INFINITY; n],
-                complex: Vec::new(),
-            };
-            for (k, &i) in order.iter().enumerate() {
-                match paths.shadow[i as usize * lights + l] {
-                    Shadow::Lit => {}
-                    Shadow::Dark => p.vis[k] = 0.0,
-                    Shadow::Test { start, len } => {
-                        let occ = &paths.occluders[start as usize..(start + len) as usize];
-                        match occ {
-                            [Occluder::Cone {
-                                axis,
-                                cos_max,
-                                center_dist,
-                                ..
-                            }] => {
-                                let q = *axis * *center_dist;
-                                p.qx[k] = q.x as f32;
-                                p.qy[k] = q.y as f32;
-                                p.qz[k] = q.z as f32;
-                                p.qc[k] = (center_dist * center_dist * cos_max * cos_max) as f32;
-                            }
-                            _ => p.complex.push((k as u32, i)),
-                        }
-                    }
-                }
+            if cancelled() {
+                return None;
             }
-            packs.push(p);
+            packs.push(LightPack::of(paths, &order, lights, l));
         }
         let direct = paths.samples_per_pixel == 1 && v.iter().all(|x| x.parent == NO_PARENT);
-        Packed {
+        let coords: [fn(&Vertex) -> f64; 9] = [
+            |x| x.p.x,
+            |x| x.p.y,
+            |x| x.p.z,
+            |x| x.n.x,
+            |x| x.n.y,
+            |x| x.n.z,
+            |x| x.v.x,
+            |x| x.v.y,
+            |x| x.v.z,
+        ];
+        let mut cols = Vec::with_capacity(coords.len());
+        for f in coords {
+            if cancelled() {
+                return None;
+            }
+            cols.push(order.iter().map(|&i| f(&v[i as usize]) as f32).collect());
+        }
+        let [px, py, pz, nx, ny, nz, vx, vy, vz]: [Vec<f32>; 9] =
+            cols.try_into().expect("one column per coordinate");
+        Some(Packed {
             n,
             groups,
             bounce: std::sync::OnceLock::new(),
             others: std::sync::OnceLock::new(),
-            px: col(&|i| v[i].p.x),
-            py: col(&|i| v[i].p.y),
-            pz: col(&|i| v[i].p.z),
-            nx: col(&|i| v[i].n.x),
-            ny: col(&|i| v[i].n.y),
-            nz: col(&|i| v[i].n.z),
-            vx: col(&|i| v[i].v.x),
-            vy: col(&|i| v[i].v.y),
-            vz: col(&|i| v[i].v.z),
+            px,
+            py,
+            pz,
+            nx,
+            ny,
+            nz,
+            vx,
+            vy,
+            vz,
             direct_pixel: direct.then(|| order.iter().map(|&i| v[i as usize].pixel).collect()),
             packed_of,
             lights: packs,
-        }
+        })
     }
 
     /// The one-bounce kernel of these hits.

@@ -165,37 +165,51 @@ impl Paths {
         } else {
             vec![trace_rows(0..h)]
         };
-        // The first part is taken as it is; the others are appended to it.
-        let mut parts = parts.into_iter();
-        let (verts, shadow, occluders) = parts.next().unwrap_or_default();
         let mut paths = Paths {
             width: w,
             height: h,
             samples_per_pixel: aa * aa,
-            verts,
-            shadow,
-            occluders,
+            verts: Vec::new(),
+            shadow: Vec::new(),
+            occluders: Vec::new(),
             geometry,
         };
+        paths.join(parts);
+        paths
+    }
+}
+
+impl Paths {
+    /// Appends the rows traced apart, in order, renumbering the links
+    /// between them. Cut short on Ctrl-C: on a large image the joining
+    /// and the packing after it take seconds, and what is left of a
+    /// cancelled build is never drawn (mod.rs), so it is left empty.
+    fn join(&mut self, parts: Vec<(Vec<Vertex>, Vec<Shadow>, Vec<Occluder>)>) {
+        let cancelled = crate::exec::cancel::is_cancelled;
         for (verts, shadow, occluders) in parts {
-            let base_v = paths.verts.len() as u32;
-            let base_o = paths.occluders.len() as u32;
-            paths.verts.extend(verts.into_iter().map(|mut v| {
+            if cancelled() {
+                self.verts.clear();
+                self.shadow.clear();
+                self.occluders.clear();
+                return;
+            }
+            let base_v = self.verts.len() as u32;
+            let base_o = self.occluders.len() as u32;
+            self.verts.extend(verts.into_iter().map(|mut v| {
                 if v.parent != NO_PARENT {
                     v.parent += base_v;
                 }
                 v
             }));
-            paths.shadow.extend(shadow.into_iter().map(|s| match s {
+            self.shadow.extend(shadow.into_iter().map(|s| match s {
                 Shadow::Test { start, len } => Shadow::Test {
                     start: start + base_o,
                     len,
                 },
                 other => other,
             }));
-            paths.occluders.extend(occluders);
+            self.occluders.extend(occluders);
         }
-        paths
     }
 }
 
@@ -364,7 +378,7 @@ mod tests {
     #[test]
     fn culled_camera_rays_hit_what_every_primitive_would() {
         let mut beside = example("sphere_floor.json");
-        let cam = V3::from(beside.camera.position);
+        let cam = V3::from(beside.camera.eye());
         let c = cam + V3::new(0.6, 0.0, 0.0);
         beside.objects[0]
             .shape

@@ -136,35 +136,25 @@ fn shade_into(
 ) {
     let mats = materials(scene);
     fill_ambient(packed, &mats, r, g, b);
-    if maps.iter().all(Option::is_none) {
-        for (l, light) in scene.lights.iter().enumerate() {
-            let lamp = lamp(light);
-            if lamp.power == [0.0; 3] || cancelled() {
-                continue;
-            }
-            light_visibility(paths, packed, l, &lamp, e, nh);
-            if cancelled() {
-                return;
-            }
-            add_diffuse(packed, &mats, &lamp, e, r, g, b);
-            add_specular(packed, &mats, &lamp, e, nh, r, g, b);
+    // With albedo maps the specular terms are kept apart, so that only the
+    // diffuse ones are mapped.
+    let n = packed.n;
+    let mut specular = maps
+        .iter()
+        .any(Option::is_some)
+        .then(|| (vec![0f32; n], vec![0f32; n], vec![0f32; n]));
+    for (l, light) in scene.lights.iter().enumerate() {
+        let lamp = lamp(light);
+        if lamp.power == [0.0; 3] || cancelled() {
+            continue;
         }
-    } else {
-        // The specular terms apart, so that only the diffuse ones are mapped.
-        let n = packed.n;
-        let (mut sr, mut sg, mut sb) = (vec![0f32; n], vec![0f32; n], vec![0f32; n]);
-        for (l, light) in scene.lights.iter().enumerate() {
-            let lamp = lamp(light);
-            if lamp.power == [0.0; 3] || cancelled() {
-                continue;
-            }
-            light_visibility(paths, packed, l, &lamp, e, nh);
-            if cancelled() {
-                return;
-            }
-            add_diffuse(packed, &mats, &lamp, e, r, g, b);
-            add_specular(packed, &mats, &lamp, e, nh, &mut sr, &mut sg, &mut sb);
+        light_visibility(paths, packed, l, &lamp, e, nh);
+        if cancelled() {
+            return;
         }
+        add_light(packed, &mats, &lamp, e, nh, r, g, b, specular.as_mut());
+    }
+    if let Some((sr, sg, sb)) = specular {
         apply_maps(paths, packed, maps, r, g, b);
         for i in 0..n {
             r[i] += sr[i];
@@ -238,39 +228,6 @@ fn light_visibility(
     }
 }
 
-/// Adds one light's diffuse contribution, material by material.
-#[inline(always)]
-fn add_diffuse(
-    packed: &Packed,
-    mats: &[Mat],
-    lamp: &Lamp,
-    e: &[f32],
-    r: &mut [f32],
-    g: &mut [f32],
-    b: &mut [f32],
-) {
-    for grp in &packed.groups {
-        let m = &mats[grp.object as usize];
-        let range = grp.start..grp.end;
-        let k = [
-            m.diffuse[0] * lamp.power[0],
-            m.diffuse[1] * lamp.power[1],
-            m.diffuse[2] * lamp.power[2],
-        ];
-        if let Some(f90) = m.f90 {
-            super::effects::grazing_diffuse(packed, range, f90, lamp.point, lamp.at, k, e, r, g, b);
-            continue;
-        }
-        accumulate(
-            &e[range.clone()],
-            k,
-            &mut r[range.clone()],
-            &mut g[range.clone()],
-            &mut b[range],
-        );
-    }
-}
-
 /// Multiplies the diffuse and ambient terms of every camera ray's first
 /// hit on a mapped object by the map at the ray's pixel.
 fn apply_maps(
@@ -309,10 +266,13 @@ fn apply_maps(
     }
 }
 
-/// Adds one light's specular contribution, material by material.
+/// Adds one light's diffuse and specular contributions, material by
+/// material: the specular ones into `apart` when albedo maps keep them
+/// apart, else with the diffuse ones. Each value gets its diffuse term
+/// before its specular one, as the shading equation adds them.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
-fn add_specular(
+fn add_light(
     packed: &Packed,
     mats: &[Mat],
     lamp: &Lamp,
@@ -321,10 +281,28 @@ fn add_specular(
     r: &mut [f32],
     g: &mut [f32],
     b: &mut [f32],
+    mut apart: Option<&mut Channels>,
 ) {
     for grp in &packed.groups {
         let m = &mats[grp.object as usize];
         let range = grp.start..grp.end;
+        let k = [
+            m.diffuse[0] * lamp.power[0],
+            m.diffuse[1] * lamp.power[1],
+            m.diffuse[2] * lamp.power[2],
+        ];
+        if let Some(f90) = m.f90 {
+            let (point, at) = (lamp.point, lamp.at);
+            super::effects::grazing_diffuse(packed, range.clone(), f90, point, at, k, e, r, g, b);
+        } else {
+            let at = range.clone();
+            let (rr, rg, rb) = (&mut r[at.clone()], &mut g[at.clone()], &mut b[at.clone()]);
+            accumulate(&e[at], k, rr, rg, rb);
+        }
+        let (r, g, b) = match apart.as_deref_mut() {
+            Some((sr, sg, sb)) => (&mut sr[..], &mut sg[..], &mut sb[..]),
+            None => (&mut *r, &mut *g, &mut *b),
+        };
         if m.general_specular() {
             let lobes = super::effects::Lobes {
                 spec: m.spec,
@@ -333,9 +311,8 @@ fn add_specular(
                 shininess2: m.shininess2,
                 fresnel: m.fresnel,
             };
-            super::effects::specular(
-                packed, range, &lobes, lamp.point, lamp.at, lamp.power, e, r, g, b,
-            );
+            let (point, at, power) = (lamp.point, lamp.at, lamp.power);
+            super::effects::specular(packed, range, &lobes, point, at, power, e, r, g, b);
         } else if m.spec > 0.0 {
             for i in range {
                 if e[i] > 0.0 && nh[i] > m.min_cos {
@@ -348,6 +325,9 @@ fn add_specular(
         }
     }
 }
+
+/// Three channels of per-value sums.
+type Channels = (Vec<f32>, Vec<f32>, Vec<f32>);
 
 /// One hit per pixel: encode in hit order (vectorised), then place the bytes.
 #[inline(always)]
