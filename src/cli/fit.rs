@@ -75,11 +75,9 @@ impl FitInputs {
     }
 }
 
-/// Says `note` (what was left out of the photographs: saturated, NaN or
-/// infinite pixels) on stderr, with `--quiet` too: it is about the data,
-/// not progress, and a user must not miss it.
-pub fn tell(note: Option<&str>) {
-    if let Some(n) = note {
+/// Says `note` on stderr unless `quiet`.
+pub fn tell(note: Option<&str>, quiet: bool) {
+    if let (Some(n), false) = (note, quiet) {
         eprintln!("{n}");
     }
 }
@@ -159,7 +157,7 @@ pub fn run(a: FitArgs) -> Result<()> {
     let mut progress = Progress::new(a.quiet);
     let fitted = api::fit(request, &photos, &a.output, &mut progress)?;
     progress.finish();
-    tell(note.as_deref());
+    tell(note.as_deref(), a.quiet);
     if !a.quiet {
         println!("{}", summary(&fitted, photos.shots.len(), &a.output));
     }

@@ -140,7 +140,7 @@ pub fn run(a: PipelineArgs) -> Result<()> {
     if let Some(b) = progress.bar.take() {
         b.finish();
     }
-    super::fit::tell(note.as_deref());
+    super::fit::tell(note.as_deref(), a.quiet);
     let report = if a.no_report {
         None
     } else {
