@@ -489,26 +489,40 @@ mod tests {
         ];
         for (written, shape, transform) in cases {
             let (a, b) = (one(written, ""), one(shape, transform));
-            let mut hits = 0;
-            // Off-grid steps, so that no ray grazes an edge, where the
-            // last bit decides.
-            for i in 0..400 {
-                let (x, y) = (
-                    (i % 20) as f64 * 0.1037 - 1.01,
-                    (i / 20) as f64 * 0.0971 - 0.49,
-                );
-                let o = V3::new(0.313, 1.517, 5.0);
-                let d = (V3::new(x, y, 0.0) - o).normalized();
-                let (ha, hb) = (a.intersect(o, d, 1e9), b.intersect(o, d, 1e9));
-                assert_eq!(ha.is_some(), hb.is_some(), "{shape} {transform}: ray {i}");
-                if let (Some(ha), Some(hb)) = (ha, hb) {
-                    assert!((ha.t - hb.t).abs() < 1e-9, "{shape}: {} vs {}", ha.t, hb.t);
-                    assert!((ha.n.dot(hb.n).abs() - 1.0).abs() < 1e-9, "{shape}");
-                    hits += 1;
-                }
-            }
+            let hits = agree(&a, &b, &format!("{shape} {transform}"), |_, _, _, _| {});
             assert!(hits > 5, "{shape}: {hits} hits");
         }
+    }
+
+    /// Casts a 20x20 grid of rays at `a` and `b`: each must hit both or
+    /// neither, at the same distance with the same normal line; `each`
+    /// sees every ray that hits (origin, direction, `b`'s hit, its
+    /// number). Returns the hits. Off-grid steps, so that no ray grazes
+    /// an edge, where the last bit decides.
+    fn agree(
+        a: &Geometry,
+        b: &Geometry,
+        what: &str,
+        mut each: impl FnMut(V3, V3, &Hit, usize),
+    ) -> usize {
+        let mut hits = 0;
+        for i in 0..400 {
+            let (x, y) = (
+                (i % 20) as f64 * 0.1037 - 1.01,
+                (i / 20) as f64 * 0.0971 - 0.49,
+            );
+            let o = V3::new(0.313, 1.517, 5.0);
+            let d = (V3::new(x, y, 0.0) - o).normalized();
+            let (ha, hb) = (a.intersect(o, d, 1e9), b.intersect(o, d, 1e9));
+            assert_eq!(ha.is_some(), hb.is_some(), "{what}: ray {i}");
+            if let (Some(ha), Some(hb)) = (ha, hb) {
+                assert!((ha.t - hb.t).abs() < 1e-9, "{what}: {} vs {}", ha.t, hb.t);
+                assert!((ha.n.dot(hb.n).abs() - 1.0).abs() < 1e-9, "{what}");
+                each(o, d, &hb, i);
+                hits += 1;
+            }
+        }
+        hits
     }
 
     /// A box's twelve triangles as an ASCII PLY file in `dir`.
@@ -544,30 +558,11 @@ mod tests {
         ] {
             let (a, b) = (one(cube, transform), one(&mesh, transform));
             assert!(!b.prims[0].convex());
-            let mut hits = 0;
-            for i in 0..400 {
-                let (x, y) = (
-                    (i % 20) as f64 * 0.1037 - 1.01,
-                    (i / 20) as f64 * 0.0971 - 0.49,
-                );
-                let o = V3::new(0.313, 1.517, 5.0);
-                let d = (V3::new(x, y, 0.0) - o).normalized();
-                let (ha, hb) = (a.intersect(o, d, 1e9), b.intersect(o, d, 1e9));
-                assert_eq!(ha.is_some(), hb.is_some(), "{transform}: ray {i}");
-                if let (Some(ha), Some(hb)) = (ha, hb) {
-                    assert!(
-                        (ha.t - hb.t).abs() < 1e-9,
-                        "{transform}: {} vs {}",
-                        ha.t,
-                        hb.t
-                    );
-                    assert!((ha.n.dot(hb.n).abs() - 1.0).abs() < 1e-9, "{transform}");
-                    // from the far side of the hit, back through the mesh: it shadows itself
-                    let p = o + d * (hb.t + 1e-3);
-                    assert!(b.blocked_by_others(p, -d, 1.0, 0), "{transform}: ray {i}");
-                    hits += 1;
-                }
-            }
+            let hits = agree(&a, &b, transform, |o, d, hb, i| {
+                // from the far side of the hit, back through the mesh: it shadows itself
+                let p = o + d * (hb.t + 1e-3);
+                assert!(b.blocked_by_others(p, -d, 1.0, 0), "{transform}: ray {i}");
+            });
             assert!(hits > 50, "{transform}: {hits} hits");
         }
     }
