@@ -72,10 +72,20 @@ impl fmt::Display for Strategy {
 
 /// A strategy name that is not one of [`Strategy::ALL`].
 #[derive(Clone, Debug, PartialEq, Eq, Error)]
-#[error("unknown search strategy `{given}`; valid names are: rand1bin, jde, shade, hybrid")]
+#[error(
+    "unknown search strategy `{given}`; valid names are: {}",
+    valid_names()
+)]
 pub struct ParseStrategyError {
     /// The text that failed to parse, as given.
     pub given: String,
+}
+
+/// The names of [`Strategy::ALL`], comma-separated: the error lists them from
+/// the registry, so a new strategy needs no edit here.
+fn valid_names() -> String {
+    let names: Vec<&str> = Strategy::ALL.iter().map(|s| s.name()).collect();
+    names.join(", ")
 }
 
 impl FromStr for Strategy {
