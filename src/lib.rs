@@ -10,6 +10,7 @@ pub mod exec;
 pub mod fit;
 pub mod fsio;
 pub mod input;
+pub mod interchange;
 pub mod math;
 pub mod metric;
 pub mod optimize;

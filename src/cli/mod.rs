@@ -1,11 +1,12 @@
 //! The command line (docs/usage.md): `demo`, `render`, `fit`, `pipeline`,
-//! `diagnose`, `report`. Each subcommand lives in its own file; this one parses and dispatches,
+//! `diagnose`, `report`, `import-cameras`. Each subcommand lives in its own file; this one parses and dispatches,
 //! and turns errors into one line and an exit code.
 
 mod demo;
 mod diagnose;
 mod env;
 mod fit;
+mod import_cameras;
 mod numbers;
 mod pipeline;
 mod progress;
@@ -41,6 +42,8 @@ enum Command {
     Pipeline(pipeline::PipelineArgs),
     /// (Re)write report.html of a fit or pipeline directory.
     Report(report::ReportArgs),
+    /// Cameras from COLMAP or OpenCV calibration as a shots file (docs/interchange.md).
+    ImportCameras(import_cameras::ImportCamerasArgs),
 }
 
 /// Runs the command line; returns the process exit code.
@@ -76,6 +79,7 @@ pub fn main() -> i32 {
         Command::Diagnose(a) => diagnose::run(a),
         Command::Pipeline(a) => pipeline::run(a),
         Command::Report(a) => report::run(a),
+        Command::ImportCameras(a) => import_cameras::run(a),
     };
     match result {
         Ok(()) => 0,

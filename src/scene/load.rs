@@ -212,6 +212,18 @@ fn numbers_in_range(
     Ok(())
 }
 
+/// `camera.distortion.k1|k2|p1|p2|k3`: its slot in the five-number array
+/// (the field path names it, the file holds a list).
+fn distortion_slot<'a>(
+    node: &'a mut serde_json::Value,
+    key: &str,
+) -> Option<&'a mut serde_json::Value> {
+    let i = super::field::DISTORTION_KEYS
+        .iter()
+        .position(|k| *k == key)?;
+    node.as_array_mut()?.get_mut(i)
+}
+
 /// Sets the JSON value at a dotted path in which `lights.NAME` and
 /// `objects.NAME` select list entries by name.
 fn apply_override(root: &mut serde_json::Value, o: &Override) -> std::result::Result<(), String> {
@@ -222,6 +234,12 @@ fn apply_override(root: &mut serde_json::Value, o: &Override) -> std::result::Re
         let key = parts[i];
         let last = i + 1 == parts.len();
         let named_list = (key == "lights" || key == "objects") && i == 0;
+        if last && parts[..i] == ["camera", "distortion"] {
+            if let Some(slot) = distortion_slot(node, key) {
+                *slot = o.value.clone();
+                return Ok(());
+            }
+        }
         let obj = node
             .as_object_mut()
             .ok_or_else(|| format!("{} is not an object", quote(&parts[..i].join("."))))?;
@@ -251,4 +269,21 @@ fn apply_override(root: &mut serde_json::Value, o: &Override) -> std::result::Re
         }
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `camera.distortion.p1` names the third of the file's five numbers.
+    #[test]
+    fn a_distortion_coefficient_is_set_by_its_name() {
+        let text = std::fs::read_to_string("scenes/pinhole_crate.json").unwrap();
+        let o = Override {
+            path: "camera.distortion.p1".into(),
+            value: serde_json::json!(0.004),
+        };
+        let s = parse(&text, "pinhole_crate.json", &[o]).unwrap();
+        assert_eq!(s.camera.distortion, Some([-0.1, 0.02, 0.004, 0.0, 0.0]));
+    }
 }
