@@ -58,6 +58,14 @@ pub trait Intersect {
     /// Distance and unit geometric normal of the nearest hit.
     fn hit(&self, o: V3, d: V3, t_max: f64) -> Option<(f64, V3)>;
 
+    /// The nearest hit with the face's own normal besides: distance, unit
+    /// normal (the shading one), unit face normal. The same normal twice
+    /// by default: only a mesh's two differ.
+    #[inline(always)]
+    fn hit_face(&self, o: V3, d: V3, t_max: f64) -> Option<(f64, V3, V3)> {
+        self.hit(o, d, t_max).map(|(t, n)| (t, n, n))
+    }
+
     /// A shadow ray's test: any hit at all?
     fn hits_before(&self, o: V3, d: V3, t_max: f64) -> bool {
         self.hit(o, d, t_max).is_some()
@@ -86,8 +94,8 @@ impl Accel {
     }
 
     /// The nearest hit within (EPS, t_max) among the items `keep` accepts:
-    /// index, distance, normal. Of two hits at the same distance the first
-    /// item's is kept.
+    /// index, distance, normal, face normal. Of two hits at the same
+    /// distance the first item's is kept.
     #[inline(always)]
     pub fn nearest<T: Intersect>(
         &self,
@@ -96,16 +104,16 @@ impl Accel {
         d: V3,
         t_max: f64,
         keep: impl Fn(usize) -> bool,
-    ) -> Option<(usize, f64, V3)> {
+    ) -> Option<(usize, f64, V3, V3)> {
         let mut best = None;
         let mut t_best = t_max;
         for (i, item) in items.iter().enumerate() {
             if !keep(i) {
                 continue;
             }
-            if let Some((t, n)) = item.hit(o, d, t_best) {
+            if let Some((t, n, ng)) = item.hit_face(o, d, t_best) {
                 t_best = t;
-                best = Some((i, t, n));
+                best = Some((i, t, n, ng));
             }
         }
         best

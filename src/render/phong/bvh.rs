@@ -1,40 +1,21 @@
 //! A bounding volume hierarchy over boxes: binned surface-area-heuristic
-//! build, front-to-back walk. Our own rather than a crate: the tracer works
-//! in f64 with its own vector type and hit rules (`Intersect`), and the
-//! crates that fit (`bvh`, `obvhs`) bring f32 nalgebra/glam types and
-//! their own ray and shape traits; this is ~200 lines, deterministic
-//! (sequential build, same tree for the same input) and its cost is
-//! measured in `benches/render.rs`.
+//! build (`bvh_build.rs`), front-to-back walk. Our own rather than a
+//! crate: the tracer works in f64 with its own vector type and hit rules
+//! (`Intersect`), and the crates that fit (`bvh`, `obvhs`) bring f32
+//! nalgebra/glam types and their own ray and shape traits; this is a few
+//! hundred lines, deterministic (the same tree for the same input on any
+//! number of threads) and its cost is measured in `benches/mesh.rs`.
 //!
 //! Items are addressed by their position in [`Bvh::order`]: the caller
 //! stores them in that order, so that a leaf's items are contiguous.
 
 use super::accel::Aabb;
+use super::bvh_build::{self, Item, Node, SAH_DEPTH};
 use crate::math::V3;
 
-/// Items per leaf below which a node is never split.
-const LEAF: usize = 2;
-/// Items per leaf above which a node is always split (by the median when
-/// the heuristic finds no better cut), so that no leaf holds thousands of
-/// identical triangles.
-const MAX_LEAF: usize = 8;
-/// Bins per axis of the binned build.
-const BINS: usize = 12;
-/// Depth below which the heuristic chooses cuts; deeper, every cut is a
-/// median split, which halves the count: so no path is longer than
-/// SAH_DEPTH + 64 and the walk's stack of STACK entries never overflows.
-const SAH_DEPTH: usize = 32;
+/// The walk's stack: deep enough for any tree the build makes
+/// (`bvh_build::SAH_DEPTH`).
 const STACK: usize = SAH_DEPTH + 66;
-
-#[derive(Clone, Copy, Debug)]
-struct Node {
-    lo: [f64; 3],
-    hi: [f64; 3],
-    /// Leaf: the first item; interior: the left child (the right is next).
-    first: u32,
-    /// Items of a leaf; 0 for an interior node.
-    count: u32,
-}
 
 /// The hierarchy; `order[k]` is the input index of the item at position k.
 #[derive(Clone, Debug)]
@@ -43,91 +24,29 @@ pub struct Bvh {
     pub order: Vec<u32>,
 }
 
-fn area(lo: [f64; 3], hi: [f64; 3]) -> f64 {
-    let d = [hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]];
-    2.0 * (d[0] * d[1] + d[1] * d[2] + d[2] * d[0])
-}
-
-#[derive(Clone, Copy)]
-struct Bin {
-    n: usize,
-    lo: [f64; 3],
-    hi: [f64; 3],
-}
-
-const EMPTY: Bin = Bin {
-    n: 0,
-    lo: [f64::INFINITY; 3],
-    hi: [f64::NEG_INFINITY; 3],
-};
-
-impl Bin {
-    fn add(&mut self, lo: [f64; 3], hi: [f64; 3], n: usize) {
-        self.n += n;
-        for a in 0..3 {
-            self.lo[a] = self.lo[a].min(lo[a]);
-            self.hi[a] = self.hi[a].max(hi[a]);
-        }
-    }
-}
-
 impl Bvh {
     /// The hierarchy over `boxes` (finite boxes; an empty list gives an
-    /// empty tree that nothing hits).
+    /// empty tree that nothing hits). The same tree whatever the number
+    /// of threads (`bvh_build.rs`).
     pub fn build(boxes: &[Aabb]) -> Bvh {
-        let lo: Vec<[f64; 3]> = boxes.iter().map(|b| b.lo.to_array()).collect();
-        let hi: Vec<[f64; 3]> = boxes.iter().map(|b| b.hi.to_array()).collect();
-        let cent: Vec<[f64; 3]> = (0..boxes.len())
-            .map(|i| [0, 1, 2].map(|a| 0.5 * (lo[i][a] + hi[i][a])))
+        let mut items: Vec<Item> = boxes
+            .iter()
+            .enumerate()
+            .map(|(i, b)| Item {
+                lo: b.lo.to_array(),
+                hi: b.hi.to_array(),
+                index: i as u32,
+            })
             .collect();
-        let mut order: Vec<u32> = (0..boxes.len() as u32).collect();
-        let mut nodes = vec![Node {
-            lo: [0.0; 3],
-            hi: [0.0; 3],
-            first: 0,
-            count: 0,
-        }];
-        let mut todo = vec![(0usize, 0usize, boxes.len(), 0usize)];
-        while let Some((ni, s, e, depth)) = todo.pop() {
-            let mut all = EMPTY;
-            let mut cb = EMPTY;
-            for &i in &order[s..e] {
-                let i = i as usize;
-                all.add(lo[i], hi[i], 1);
-                cb.add(cent[i], cent[i], 0);
-            }
-            nodes[ni].lo = all.lo;
-            nodes[ni].hi = all.hi;
-            let items = &mut order[s..e];
-            let mid = if e - s <= LEAF {
-                None
-            } else if depth >= SAH_DEPTH {
-                (e - s > MAX_LEAF).then(|| median(items, &cent, &cb))
-            } else {
-                let sah = split(items, &lo, &hi, &cent, &cb, area(all.lo, all.hi));
-                sah.or_else(|| (e - s > MAX_LEAF).then(|| median(items, &cent, &cb)))
-            };
-            match mid {
-                Some(m) => {
-                    let left = nodes.len();
-                    nodes.push(nodes[ni]);
-                    nodes.push(nodes[ni]);
-                    nodes[ni].first = left as u32;
-                    nodes[ni].count = 0;
-                    todo.push((left, s, s + m, depth + 1));
-                    todo.push((left + 1, s + m, e, depth + 1));
-                }
-                None => {
-                    nodes[ni].first = s as u32;
-                    nodes[ni].count = (e - s) as u32;
-                }
-            }
-        }
+        let mut nodes = bvh_build::tree(&mut items);
         if boxes.is_empty() {
             nodes[0].lo = [f64::INFINITY; 3];
             nodes[0].hi = [f64::NEG_INFINITY; 3];
         }
-        Bvh { nodes, order }
+        Bvh {
+            nodes,
+            order: items.iter().map(|it| it.index).collect(),
+        }
     }
 
     /// The nearest item hit within (…, t_max): `hit(k, t_best)` tests the
@@ -163,6 +82,35 @@ impl Bvh {
             (!found).then_some(t_max)
         });
         found
+    }
+
+    /// True when `item(k)` holds for an item of a leaf reached through
+    /// boxes that `enter(lo, hi)` accepts (a query that is not a ray).
+    pub fn any_box(
+        &self,
+        enter: impl Fn(&[f64; 3], &[f64; 3]) -> bool,
+        mut item: impl FnMut(usize) -> bool,
+    ) -> bool {
+        if self.order.is_empty() {
+            return false;
+        }
+        let mut stack = vec![0usize];
+        while let Some(i) = stack.pop() {
+            let n = &self.nodes[i];
+            if !enter(&n.lo, &n.hi) {
+                continue;
+            }
+            if n.count > 0 {
+                let items = n.first as usize..(n.first + n.count) as usize;
+                if items.into_iter().any(&mut item) {
+                    return true;
+                }
+            } else {
+                stack.push(n.first as usize + 1);
+                stack.push(n.first as usize);
+            }
+        }
+        false
     }
 
     /// Visits the items of the leaves whose boxes the ray meets before the
@@ -237,87 +185,6 @@ impl Bvh {
     }
 }
 
-/// The binned surface-area split of `items`: the count that goes left,
-/// after partitioning them, or `None` when no split beats a leaf.
-fn split(
-    items: &mut [u32],
-    lo: &[[f64; 3]],
-    hi: &[[f64; 3]],
-    cent: &[[f64; 3]],
-    cb: &Bin,
-    parent_area: f64,
-) -> Option<usize> {
-    #![allow(clippy::needless_range_loop)] // `a` indexes every point's coordinates
-    let n = items.len();
-    let mut best: Option<(f64, usize, usize)> = None; // cost, axis, bins on the left
-    for a in 0..3 {
-        let extent = cb.hi[a] - cb.lo[a];
-        if extent.is_nan() || extent <= 0.0 {
-            continue;
-        }
-        let scale = BINS as f64 / extent;
-        let bin_of = |i: usize| (((cent[i][a] - cb.lo[a]) * scale) as usize).min(BINS - 1);
-        let mut bins = [EMPTY; BINS];
-        for &i in items.iter() {
-            let i = i as usize;
-            bins[bin_of(i)].add(lo[i], hi[i], 1);
-        }
-        let mut right = [0.0; BINS];
-        let mut acc = EMPTY;
-        for b in (1..BINS).rev() {
-            acc.add(bins[b].lo, bins[b].hi, bins[b].n);
-            right[b] = acc.n as f64 * if acc.n > 0 { area(acc.lo, acc.hi) } else { 0.0 };
-        }
-        let mut left = EMPTY;
-        for b in 1..BINS {
-            left.add(bins[b - 1].lo, bins[b - 1].hi, bins[b - 1].n);
-            if left.n == 0 || left.n == n {
-                continue;
-            }
-            let cost = left.n as f64 * area(left.lo, left.hi) + right[b];
-            if best.is_none_or(|(c, _, _)| cost < c) {
-                best = Some((cost, a, b));
-            }
-        }
-    }
-    let (cost, a, b) = best?;
-    // a leaf costs one test per item; a split one box test more per side
-    if n <= MAX_LEAF && cost >= (n as f64 - 1.0) * parent_area {
-        return None;
-    }
-    let scale = BINS as f64 / (cb.hi[a] - cb.lo[a]);
-    let goes_left =
-        |i: u32| ((((cent[i as usize][a] - cb.lo[a]) * scale) as usize).min(BINS - 1)) < b;
-    Some(partition(items, goes_left))
-}
-
-/// Half the items on each side of the median centroid along the longest
-/// axis of the centroids' box.
-fn median(items: &mut [u32], cent: &[[f64; 3]], cb: &Bin) -> usize {
-    let a = (0..3)
-        .max_by(|&x, &y| (cb.hi[x] - cb.lo[x]).total_cmp(&(cb.hi[y] - cb.lo[y])))
-        .unwrap_or(0);
-    let m = items.len() / 2;
-    items.select_nth_unstable_by(m, |&x, &y| {
-        cent[x as usize][a]
-            .total_cmp(&cent[y as usize][a])
-            .then(x.cmp(&y))
-    });
-    m
-}
-
-/// Moves the items `left` accepts to the front; returns their count.
-fn partition(items: &mut [u32], left: impl Fn(u32) -> bool) -> usize {
-    let mut k = 0;
-    for j in 0..items.len() {
-        if left(items[j]) {
-            items.swap(k, j);
-            k += 1;
-        }
-    }
-    k
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -390,7 +257,10 @@ mod tests {
     fn identical_items_are_split_by_count_and_the_build_is_deterministic() {
         let boxes = vec![cube(V3::new(0.0, 0.0, 0.0), 1.0); 5000];
         let bvh = Bvh::build(&boxes);
-        assert!(bvh.nodes.iter().all(|n| n.count as usize <= MAX_LEAF));
+        assert!(bvh
+            .nodes
+            .iter()
+            .all(|n| n.count as usize <= bvh_build::MAX_LEAF));
         assert_eq!(bvh.order, Bvh::build(&boxes).order);
         assert!(Bvh::build(&[])
             .nearest(
@@ -400,5 +270,31 @@ mod tests {
                 |_, _| Some(0.5)
             )
             .is_none());
+    }
+
+    /// The build on two threads makes the tree it makes on one: boxes
+    /// enough for the parallel build (more than `PARALLEL_MIN`).
+    #[test]
+    fn the_tree_does_not_depend_on_the_thread_count() {
+        let boxes: Vec<Aabb> = (0..40_000)
+            .map(|i| {
+                let f = i as f64;
+                cube(
+                    V3::new((f * 0.37).sin(), (f * 0.91).cos(), (f * 0.13).sin()) * 5.0,
+                    0.01 + 0.01 * (f * 0.7).sin().abs(),
+                )
+            })
+            .collect();
+        let on = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            pool.install(|| Bvh::build(&boxes))
+        };
+        let (one, two) = (on(1), on(2));
+        assert_eq!(one.order, two.order);
+        assert_eq!(one.nodes, two.nodes);
+        assert!(one.nodes.len() > 40_000 / bvh_build::MAX_LEAF);
     }
 }

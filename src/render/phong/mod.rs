@@ -18,6 +18,7 @@
 mod accel;
 mod bounce;
 mod bvh;
+mod bvh_build;
 mod camera;
 mod effects;
 mod geometry;

@@ -243,6 +243,11 @@ impl Tracer<'_> {
         let p = o + d * hit.t;
         let entering = hit.n.dot(d) < 0.0;
         let n = if entering { hit.n } else { -hit.n };
+        let face = if hit.face.dot(d) < 0.0 {
+            hit.face
+        } else {
+            -hit.face
+        };
         let index = self.verts.len() as u32;
         self.verts.push(Vertex {
             pixel,
@@ -254,7 +259,7 @@ impl Tracer<'_> {
             v: -d,
         });
         for l in 0..self.scene.lights.len() {
-            let s = self.classify(p, n, hit.object, l);
+            let s = self.classify(p, n, face, hit.object, l);
             self.shadow.push(s);
         }
         self.budget = self.budget.saturating_sub(1);
@@ -294,8 +299,9 @@ impl Tracer<'_> {
         }
     }
 
-    /// Which primitives could shadow point `p` (normal `n`, on `object`) from light `l`.
-    fn classify(&mut self, p: V3, n: V3, object: u32, l: usize) -> Shadow {
+    /// Which primitives could shadow point `p` (normal `n`, face normal
+    /// `face`, on `object`) from light `l`.
+    fn classify(&mut self, p: V3, n: V3, face: V3, object: u32, l: usize) -> Shadow {
         let light = &self.scene.lights[l];
         let g = self.geometry;
         let others = |i: &usize| g.may_shadow(*i, object);
@@ -326,7 +332,7 @@ impl Tracer<'_> {
             (0..g.prims.len())
                 .filter(others)
                 .filter(|&i| bounds.is_none_or(|(lo, hi)| g.prims[i].may_block(p, lo, hi)))
-                .map(|i| g.occluder(i as u32, p)),
+                .map(|i| g.occluder(i as u32, p, face)),
         );
         let len = self.occluders.len() as u32 - start;
         if len == 0 {

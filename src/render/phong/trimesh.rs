@@ -53,6 +53,8 @@ pub struct TriMesh {
     normals: Vec<[V3; 3]>,
     bvh: Bvh,
     pub bounds: Aabb,
+    /// A sphere holding every vertex: centre and radius.
+    sphere: (V3, f64),
 }
 
 impl TriMesh {
@@ -86,6 +88,12 @@ impl TriMesh {
                 .collect()
         };
         let (lo, hi) = m.bounds();
+        let centre = (V3::from(lo) + V3::from(hi)) * 0.5;
+        let radius = m
+            .positions
+            .iter()
+            .map(|&v| (V3::from(v) - centre).length())
+            .fold(0.0, f64::max);
         TriMesh {
             tris,
             normals,
@@ -94,15 +102,36 @@ impl TriMesh {
                 lo: V3::from(lo),
                 hi: V3::from(hi),
             },
+            sphere: (centre, radius),
         }
     }
 
-    /// The nearest hit: distance and the shading normal (not unit): the
-    /// vertex normals interpolated, or the face normal; on the side of the
+    /// True when some vertex x has x . m > thr: the mesh reaches above
+    /// that plane. Boxes wholly below it are skipped, so near a convex
+    /// part only the few leaves the plane cuts are read.
+    pub fn reaches_above(&self, m: V3, thr: f64) -> bool {
+        let m = m.to_array();
+        let top = |lo: &[f64; 3], hi: &[f64; 3]| -> f64 {
+            (0..3).map(|a| (m[a] * lo[a]).max(m[a] * hi[a])).sum()
+        };
+        let m = V3::from(m);
+        self.bvh.any_box(
+            |lo, hi| top(lo, hi) > thr,
+            |k| {
+                let t = &self.tris[k];
+                [t.v0, t.v0 + t.e1, t.v0 + t.e2]
+                    .iter()
+                    .any(|v| v.dot(m) > thr)
+            },
+        )
+    }
+
+    /// The nearest hit: distance, the shading normal (not unit): the
+    /// vertex normals interpolated, or the face normal, on the side of the
     /// face the ray meets, so that the tracer's front and back agree with
-    /// the geometry.
+    /// the geometry; and the face normal (not unit).
     #[inline]
-    pub fn hit(&self, o: V3, d: V3, t_max: f64) -> Option<(f64, V3)> {
+    pub fn hit(&self, o: V3, d: V3, t_max: f64) -> Option<(f64, V3, V3)> {
         let mut uv = (0.0, 0.0);
         let (k, t) = self.bvh.nearest(o, d, t_max, |k, tb| {
             let (t, u, v) = self.tris[k].hit(o, d, tb)?;
@@ -113,7 +142,7 @@ impl TriMesh {
         let tri = &self.tris[k];
         let ng = tri.e1.cross(tri.e2);
         let Some(n) = self.normals.get(k) else {
-            return Some((t, ng));
+            return Some((t, ng, ng));
         };
         let (u, v) = uv;
         let ns = n[0] * (1.0 - u - v) + n[1] * u + n[2] * v;
@@ -121,7 +150,7 @@ impl TriMesh {
         // a shading normal turned past the ray (or zero) would flip the
         // side the tracer shades: keep the face's there
         let same_side = (ns.dot(d) < 0.0) == (ng.dot(d) < 0.0) && ns.dot(ns) > 0.0;
-        Some((t, if same_side { ns } else { ng }))
+        Some((t, if same_side { ns } else { ng }, ng))
     }
 
     /// True when any triangle is hit within (EPS, t_max).
@@ -232,16 +261,50 @@ impl Placed {
         }
     }
 
-    /// Distance and unit normal of the nearest hit.
+    /// Distance, unit shading normal and unit face normal of the nearest hit.
     #[inline]
-    pub fn hit(&self, o: V3, d: V3, t_max: f64) -> Option<(f64, V3)> {
+    pub fn hit(&self, o: V3, d: V3, t_max: f64) -> Option<(f64, V3, V3)> {
         let (ol, dl) = self.local(o, d)?;
-        let (t, n) = self.mesh.hit(ol, dl, t_max)?;
-        let n = match &self.place {
-            Place::Moved(m) => m.0.normal(n),
-            _ => n,
+        let (t, n, ng) = self.mesh.hit(ol, dl, t_max)?;
+        let (n, ng) = match &self.place {
+            Place::Moved(m) => (m.0.normal(n), m.0.normal(ng)),
+            _ => (n, ng),
         };
-        Some((t, n.normalized()))
+        Some((t, n.normalized(), ng.normalized()))
+    }
+
+    /// A sphere holding the placed mesh: centre and radius. The transform
+    /// is a rotation of a scale (`Affine`), whose largest stretch is its
+    /// longest column.
+    pub fn sphere(&self) -> (V3, f64) {
+        let (c, r) = self.mesh.sphere;
+        match &self.place {
+            Place::AsRead | Place::Flat => (c, r),
+            Place::Moved(m) => {
+                let axes = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+                let stretch = axes
+                    .iter()
+                    .map(|&e| m.0.vector(V3::from(e)).length())
+                    .fold(0.0, f64::max);
+                (m.0.point(c), r * stretch)
+            }
+        }
+    }
+
+    /// True when some point of the placed mesh has x . m > thr (world).
+    pub fn reaches_above(&self, m: V3, thr: f64) -> bool {
+        match &self.place {
+            Place::AsRead => self.mesh.reaches_above(m, thr),
+            Place::Flat => false,
+            // world x = A v + b: x . m = v . (A^T m) + b . m
+            Place::Moved(p) => {
+                let a = &p.0;
+                let axes = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+                let [x, y, z] = axes.map(|e| a.vector(V3::from(e)).dot(m));
+                let b = a.point(V3::new(0.0, 0.0, 0.0));
+                self.mesh.reaches_above(V3::new(x, y, z), thr - b.dot(m))
+            }
+        }
     }
 
     #[inline]
