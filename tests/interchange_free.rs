@@ -43,6 +43,17 @@ fn the_listing_names_every_field_with_its_value_and_whether_it_is_free() {
     assert_eq!(&intensity[1..4], ["10", "5", "20"]);
     // fields the scene lacks (a light's direction, a pinhole's fx) are not offered
     assert!(!out.contains("lights.key.direction") && !out.contains("camera.fx"));
+    // a pinhole's calibration is offered, its unused `up` is not
+    let o = scenefit(&[
+        "free",
+        concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/pinhole_crate.json"),
+    ]);
+    let out = stdout(&o);
+    assert!(
+        out.contains("camera.distortion.k3") && out.contains("camera.fx"),
+        "{out}"
+    );
+    assert!(!out.contains("camera.up"), "{out}");
 }
 
 #[test]

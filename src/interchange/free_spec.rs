@@ -12,55 +12,57 @@
 use crate::error::{Error, Result};
 use crate::math::V3;
 use crate::scene::field::{CameraField, LightField, MaterialField, TransformField};
-use crate::scene::{Bound, Field, FreeParam, Scene, Value};
+use crate::scene::{Bound, CameraKind, Field, FreeParam, Scene, Value};
 
 /// The fields every light, material, transform and camera may have; those
-/// a scene lacks do not resolve and are left out.
-const LIGHT: [&str; 7] = [
-    "position",
-    "direction",
-    "color",
-    "intensity",
-    "radius",
-    "falloff_power",
-    "distance",
+/// a scene lacks have no value and are left out. Paths are spelled by
+/// `Field::path`, the one writer of field names.
+const LIGHT: [LightField; 7] = [
+    LightField::Position,
+    LightField::Direction,
+    LightField::Color,
+    LightField::Intensity,
+    LightField::Radius,
+    LightField::FalloffPower,
+    LightField::Distance,
 ];
-const MATERIAL: [&str; 11] = [
-    "color",
-    "diffuse",
-    "specular",
-    "shininess",
-    "reflection",
-    "transmission",
-    "ior",
-    "fresnel",
-    "specular2",
-    "shininess2",
-    "diffuse_f90",
+const MATERIAL: [MaterialField; 11] = [
+    MaterialField::Color,
+    MaterialField::Diffuse,
+    MaterialField::Specular,
+    MaterialField::Shininess,
+    MaterialField::Reflection,
+    MaterialField::Transmission,
+    MaterialField::Ior,
+    MaterialField::Fresnel,
+    MaterialField::Specular2,
+    MaterialField::Shininess2,
+    MaterialField::DiffuseF90,
 ];
-const TRANSFORM: [&str; 3] = ["translate", "rotate_deg", "scale"];
-const CAMERA: [&str; 21] = [
-    "position",
-    "look_at",
-    "up",
-    "fov_y_deg",
-    "height",
-    "exposure",
-    "white_balance",
-    "fx",
-    "fy",
-    "cx",
-    "cy",
-    "rotation",
-    "translation",
-    "vignetting.strength",
-    "response.gain",
-    "response.gamma",
-    "response.black",
-    "distortion.k1",
-    "distortion.k2",
-    "distortion.p1",
-    "distortion.p2",
+const TRANSFORM: [TransformField; 3] = [
+    TransformField::Translate,
+    TransformField::RotateDeg,
+    TransformField::Scale,
+];
+const CAMERA: [CameraField; 18] = [
+    CameraField::Position,
+    CameraField::LookAt,
+    CameraField::Up,
+    CameraField::FovY,
+    CameraField::Height,
+    CameraField::Exposure,
+    CameraField::WhiteBalance,
+    CameraField::Fx,
+    CameraField::Fy,
+    CameraField::Cx,
+    CameraField::Cy,
+    CameraField::Rotation,
+    CameraField::Translation,
+    CameraField::Vignetting,
+    CameraField::ResponseGain,
+    CameraField::ResponseGamma,
+    CameraField::ResponseBlack,
+    CameraField::Distortion(0),
 ];
 
 /// One field a scene offers: its path, value and default bounds.
@@ -74,38 +76,32 @@ pub struct Offer {
 
 /// Every numeric field of `scene`, in the scene's order.
 pub fn offers(scene: &Scene) -> Vec<Offer> {
-    let mut paths = vec!["ambient".to_string(), "indirect_light".to_string()];
-    for l in &scene.lights {
-        paths.extend(LIGHT.iter().map(|f| format!("lights.{}.{f}", l.name)));
+    let mut fields = vec![Field::Ambient, Field::IndirectLight];
+    for i in 0..scene.lights.len() {
+        fields.extend(LIGHT.iter().map(|&f| Field::Light(i, f)));
     }
-    for o in &scene.objects {
-        paths.extend(
-            MATERIAL
-                .iter()
-                .map(|f| format!("objects.{}.material.{f}", o.name)),
-        );
-        let shape = o.shape.fields();
-        paths.extend(
-            shape
-                .iter()
-                .map(|(f, _)| format!("objects.{}.shape.{f}", o.name)),
-        );
-        paths.extend(
-            TRANSFORM
-                .iter()
-                .map(|f| format!("objects.{}.transform.{f}", o.name)),
-        );
+    for (i, o) in scene.objects.iter().enumerate() {
+        fields.extend(MATERIAL.iter().map(|&f| Field::Material(i, f)));
+        fields.extend(o.shape.fields().iter().map(|(f, _)| Field::Shape(i, f)));
+        fields.extend(TRANSFORM.iter().map(|&f| Field::Transform(i, f)));
     }
-    paths.extend(CAMERA.iter().map(|f| format!("camera.{f}")));
-    paths.push("camera.distortion.k3".into());
-    paths
+    for f in CAMERA {
+        match f {
+            CameraField::Distortion(_) => {
+                fields.extend((0..5).map(|k| Field::Camera(CameraField::Distortion(k))))
+            }
+            // a pinhole is placed by rotation and translation; its `up` is unused
+            CameraField::Up if scene.camera.kind == CameraKind::Pinhole => {}
+            f => fields.push(Field::Camera(f)),
+        }
+    }
+    fields
         .into_iter()
-        .filter_map(|path| {
-            let field = Field::resolve(scene, &path).ok()?;
+        .filter_map(|field| {
             let value = field.get(scene)?;
             let (min, max) = default_bounds(scene, &field, value);
             Some(Offer {
-                path,
+                path: field.path(scene),
                 value,
                 min,
                 max,
