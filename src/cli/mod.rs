@@ -1,11 +1,12 @@
 //! The command line (docs/usage.md): `demo`, `render`, `fit`, `pipeline`,
-//! `diagnose`, `report`, `import-cameras`. Each subcommand lives in its own file; this one parses and dispatches,
+//! `diagnose`, `report`, `import-cameras`, `free`. Each subcommand lives in its own file; this one parses and dispatches,
 //! and turns errors into one line and an exit code.
 
 mod demo;
 mod diagnose;
 mod env;
 mod fit;
+mod free;
 mod import_cameras;
 mod numbers;
 mod pipeline;
@@ -44,6 +45,8 @@ enum Command {
     Report(report::ReportArgs),
     /// Cameras from COLMAP or OpenCV calibration as a shots file (docs/interchange.md).
     ImportCameras(import_cameras::ImportCamerasArgs),
+    /// List the fields a scene offers as free parameters, or free those a glob matches.
+    Free(free::FreeArgs),
 }
 
 /// Runs the command line; returns the process exit code.
@@ -80,6 +83,7 @@ pub fn main() -> i32 {
         Command::Pipeline(a) => pipeline::run(a),
         Command::Report(a) => report::run(a),
         Command::ImportCameras(a) => import_cameras::run(a),
+        Command::Free(a) => free::run(a),
     };
     match result {
         Ok(()) => 0,

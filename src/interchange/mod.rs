@@ -1,11 +1,13 @@
 //! Files of other tools read into the project's formats: cameras from
 //! calibration tools (COLMAP text models, OpenCV calibration YAML) turned
-//! into a shots file (docs/interchange.md). Each reader parses its format
+//! into a shots file, and free parameters from a short spec for a scene
+//! that no one wrote by hand (docs/interchange.md). Each reader parses its format
 //! into [`camera::Calibrated`], the one pinhole in OpenCV's conventions the
 //! scene format holds; `shots_out` matches them to photographs.
 
 pub mod camera;
 pub mod colmap;
+pub mod free_spec;
 pub mod opencv_yaml;
 pub mod shots_out;
 
