@@ -23,7 +23,7 @@ pub use checkpoint::Checkpoint;
 pub use config::{FitConfig, GenerationReport};
 pub use executor::{Observer, Problem};
 pub use output::{Alternative, FitOutcome, FitResult, Population};
-pub use problem::render_seed;
+pub use problem::{counted, render_seed};
 pub use target::FitTarget;
 pub use uncertainty::{Correlation, Uncertainty};
 
@@ -35,7 +35,7 @@ use crate::rundir::{Mode, RunDir};
 use crate::scene::{ParamSpace, Scene};
 use executor::{Executor, Halt, Offsets};
 use identity::RunIdentity;
-use problem::RenderProblem;
+use problem::ShotsProblem;
 use std::path::Path;
 
 impl Observer for () {
@@ -103,11 +103,11 @@ pub fn run_in(
             Some(s) => s,
             None => new_search(config, &sub, &state.base, state.phase_index),
         };
-        let mut problem = RenderProblem::new(
+        let mut problem = ShotsProblem::new(
             session,
             sub.clone(),
-            state.base.clone(),
-            target,
+            vec![state.base.clone()],
+            vec![target],
             config.de.seed,
         );
         if search.evaluations() > 0 {
@@ -185,7 +185,7 @@ impl Logs {
 /// every generation.
 #[allow(clippy::too_many_arguments)]
 fn run_phase(
-    problem: &mut RenderProblem,
+    problem: &mut ShotsProblem,
     search: &mut Searcher,
     state: &mut Checkpoint,
     rule: StopRule,
@@ -249,7 +249,7 @@ fn run_phase(
 fn finish(
     mut state: Checkpoint,
     search: Searcher,
-    problem: RenderProblem,
+    problem: ShotsProblem,
     space: &ParamSpace,
     reason: StopReason,
     failed_renders: usize,
@@ -260,7 +260,10 @@ fn finish(
 ) -> Result<FitOutcome> {
     let sub = problem.space.clone();
     let scene = sub.scene_at(&state.base, search.best().0);
-    let image = match problem.into_best_image() {
+    let image = match problem
+        .into_best_images()
+        .and_then(|v| v.into_iter().next())
+    {
         Some(img) => img,
         None => crate::render::render_one(renderer, &scene, 0)?,
     };

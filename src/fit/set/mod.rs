@@ -25,27 +25,26 @@
 
 mod joint;
 mod outcome;
-mod problem;
 pub mod renders;
 mod setup;
 pub mod shots;
 mod state;
 
 pub use super::output::ShotResult;
+pub use crate::fit::counted;
 pub use outcome::{SetOutcome, ShotOutcome};
-pub use problem::counted;
 pub use setup::SetConfig;
 
 use super::executor::{Executor, Halt, Offsets};
 use super::{FitConfig, Observer};
 use crate::error::{Error, Result};
+use crate::fit::problem::ShotsProblem;
 use crate::fit::set::shots::Shot;
 use crate::metric::Deviation;
 use crate::optimize::{Search, Searcher, Start, StopRule};
 use crate::render::Renderer;
 use crate::rundir::{Kind, Mode, RunDir};
 use crate::scene::{ParamSpace, Scene};
-use problem::SetProblem;
 use setup::{block_seed, varying};
 use state::{SetState, Within};
 use std::path::Path;
@@ -282,7 +281,7 @@ fn own_block(
         .parts()
         .into_iter()
         .zip(shots)
-        .map(|(d, s)| (d, problem::counted(&s.target)))
+        .map(|(d, s)| (d, crate::fit::counted(&s.target)))
         .collect();
     Ok(Deviation::pooled(&parts).average)
 }
@@ -341,11 +340,11 @@ fn shared_block(
             own.scene_at(&s.scene, &state.own[i])
         })
         .collect();
-    let mut session = renderer.session(&bases[0], &varying(space, shots), config.fit.jobs)?;
+    let session = renderer.session(&bases[0], &varying(space, shots), config.fit.jobs)?;
     (steps.clear)()?;
     let targets = shots.iter().map(|s| &s.target).collect();
     let seed = block_seed(config.fit.de.seed, state.blocks_done, 0);
-    let mut problem = SetProblem::new(session.as_mut(), shared.clone(), bases, targets, seed);
+    let mut problem = ShotsProblem::new(session, shared.clone(), bases, targets, seed);
     let cfg = block_config(&config.fit, shared.dim(), seed);
     // A fresh fit's first shared block searches the whole box (the current
     // values one member of its population): the scene's values are a guess.

@@ -5,8 +5,9 @@
 //! absolute paths, for `diagnose`).
 
 use super::state::SetState;
-use super::{problem::counted, varying, SetConfig, ShotResult};
+use super::{varying, SetConfig, ShotResult};
 use crate::error::{Error, Result};
+use crate::fit::counted;
 use crate::fit::set::shots::{Shot, ShotsFile, FORMAT};
 use crate::fit::{render_seed, FitResult};
 use crate::metric::{deviation, deviation_levels, Deviation};
