@@ -35,7 +35,8 @@ pub use crate::fit::counted;
 pub use outcome::{SetOutcome, ShotOutcome};
 pub use setup::SetConfig;
 
-use super::executor::{Executor, Halt, Offsets};
+use super::executor::{Halt, Offsets};
+use super::search_run::{halt_error, Logs, SearchRun};
 use super::{FitConfig, Observer};
 use crate::error::{Error, Result};
 use crate::fit::problem::ShotsProblem;
@@ -132,6 +133,7 @@ pub fn run_in(
     let started = Instant::now();
     let before = state.seconds;
     let mut cleared = config.fit.mode != Mode::Overwrite;
+    let mut logs = None;
     let mut save = |state: &mut SetState| -> Result<()> {
         state.seconds = before + started.elapsed().as_secs_f64();
         dir.map_or(Ok(()), |d| state.save(d))
@@ -155,6 +157,7 @@ pub fn run_in(
         let mut steps = Steps {
             clear: &mut clear,
             save: &mut save,
+            logs: &mut logs,
         };
         let total = match block {
             Block::Own => own_block(&mut state, shots, renderer, config, &space, dir, &mut steps)?,
@@ -182,6 +185,8 @@ pub fn run_in(
 struct Steps<'a> {
     clear: &'a mut dyn FnMut() -> Result<()>,
     save: &'a mut dyn FnMut(&mut SetState) -> Result<()>,
+    /// progress.txt and failures.log, opened by the first shared block.
+    logs: &'a mut Option<Logs>,
 }
 
 /// A step of the alternation.
@@ -359,30 +364,35 @@ fn shared_block(
         s.set_periods(crate::fit::periods(&shared));
         s
     });
-    let mut executor = Executor {
+    let run = SearchRun {
         rule: StopRule {
             max_generations: cfg.generations,
             target: cfg.target_deviation.map(|d| 3.0 * d),
             stagnation: cfg.stagnation,
         },
-        interrupt: config.fit.interrupt.clone(),
-        observers: vec![observer],
+        offsets: Offsets {
+            generations: state.generations,
+            evaluations: state.evaluations,
+            seconds: state.seconds,
+            total_generations: state.generations + config.fit.generations,
+            phase: 1,
+        },
+        config: &config.fit,
+        dir,
     };
-    let offsets = Offsets {
-        generations: state.generations,
-        evaluations: state.evaluations,
-        seconds: state.seconds,
-        total_generations: state.generations + config.fit.generations,
-        phase: 1,
-    };
+    if search.evaluations() > 0 {
+        let (best, f) = search.best();
+        problem.adopt_best(best, f);
+    }
+    if steps.logs.is_none() {
+        *steps.logs = Some(Logs::open(dir, &config.fit)?);
+    }
+    let logs = steps.logs.as_mut().expect("opened above");
     let mut save = |s: &Searcher, _: f64| -> Result<()> {
         state.within.search = Some(s.clone());
         (steps.save)(state)
     };
-    let halted = executor.run(&mut problem, &mut search, offsets, &mut save);
-    if let Err(h) = halted {
-        return Err(halt_error(h, dir));
-    }
+    run.run(&mut problem, &mut search, logs, observer, &mut save)?;
     let n = shots.len();
     state.failed_renders += problem.failed_renders();
     state.shared = search.best().0.to_vec();
@@ -390,26 +400,4 @@ fn shared_block(
     state.generations += search.generation();
     state.shared_blocks += 1;
     Ok(search.best().1 / 3.0)
-}
-
-/// A block that stopped without a result, as the error the user sees.
-fn halt_error(h: Halt, dir: Option<&RunDir>) -> Error {
-    let place = match dir {
-        Some(d) => format!(
-            "{} resumes the run where it stopped (--resume)",
-            d.path().display()
-        ),
-        None => "nothing was saved".into(),
-    };
-    match h {
-        Halt::Error(e) => e,
-        Halt::Interrupted => Error::Run(format!("interrupted; {place}")),
-        Halt::AllFailed {
-            generation,
-            failures,
-        } => Error::Run(format!(
-            "every render of generation {generation} failed; {place}. First failure: {}",
-            failures.first().map(String::as_str).unwrap_or("?")
-        )),
-    }
 }
