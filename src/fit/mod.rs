@@ -18,7 +18,7 @@ mod problem;
 mod search_run;
 pub mod set;
 mod target;
-mod uncertainty;
+pub(crate) mod uncertainty;
 
 pub use checkpoint::Checkpoint;
 pub use config::{FitConfig, GenerationReport};

@@ -399,5 +399,7 @@ fn shared_block(
     state.evaluations += search.evaluations() * n;
     state.generations += search.generation();
     state.shared_blocks += 1;
-    Ok(search.best().1 / 3.0)
+    let average = search.best().1 / 3.0;
+    state.last_shared = Some(search);
+    Ok(average)
 }
