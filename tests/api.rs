@@ -119,5 +119,5 @@ fn a_set_of_two_photographs_goes_through_the_same_entry_point() {
     let worst = fitted.worst().expect("a set has a worst photograph");
     assert!(worst >= fitted.result().deviation.average);
     assert_eq!(fitted.result().shots.as_ref().map(Vec::len), Some(2));
-    assert!(out.join("set_state.json").is_file());
+    assert!(out.join("checkpoint.json").is_file());
 }

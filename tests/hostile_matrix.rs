@@ -148,7 +148,7 @@ const INPUTS: &[Input] = &[
             "setrun",
             "--resume",
         ],
-        file: "setrun/set_state.json",
+        file: "setrun/checkpoint.json",
         kind: Kind::Json,
         output: "setrun",
     },

@@ -110,14 +110,15 @@ impl Moments {
     }
 }
 
-/// What must match: the shared parameters, the deviation and every
-/// photograph's own parameters and deviation.
-fn outcome(dir: &Path) -> [serde_json::Value; 3] {
+/// What must match: the shared parameters, the deviation, every
+/// photograph's own parameters and deviation, and the standard errors.
+fn outcome(dir: &Path) -> [serde_json::Value; 4] {
     let r = json(&dir.join("result.json"));
     [
         r["params"].clone(),
         r["deviation"].clone(),
         r["shots"].clone(),
+        r["identifiability"].clone(),
     ]
 }
 
@@ -136,6 +137,11 @@ fn a_set_fit_killed_at_random_moments_resumes_to_the_same_result() {
     assert!(out.status.success(), "{}", stderr(&out));
     let run_ms = started.elapsed().as_millis() as u64;
     let straight = outcome(&d.path().join("straight"));
+    // The hybrid's last shared block gives the shared colour's standard
+    // errors, as a single fit's hybrid search does.
+    let r = json(&d.path().join("straight/result.json"));
+    let errors = &r["identifiability"]["standard_errors"];
+    assert!(errors["objects.ball.material.color.r"].is_number(), "{r}");
 
     let seed = std::env::var("SCENEFIT_KILL_SEED")
         .ok()
@@ -157,7 +163,7 @@ fn a_set_fit_killed_at_random_moments_resumes_to_the_same_result() {
         let mut a = args("killed");
         // Killed before its first save, the directory holds nothing to
         // resume: the run starts afresh, as the refusal advises.
-        if killed.join("set_state.json").exists() {
+        if killed.join("checkpoint.json").exists() {
             a.push("--resume".into());
         }
         let mut child = Command::new(env!("CARGO_BIN_EXE_scenefit"))
@@ -177,7 +183,7 @@ fn a_set_fit_killed_at_random_moments_resumes_to_the_same_result() {
     }
     assert!(kills >= 2, "only {kills} runs were killed before their end");
     let mut a = args("killed");
-    if killed.join("set_state.json").exists() {
+    if killed.join("checkpoint.json").exists() {
         a.push("--resume".into());
     }
     let out = scenefit(d.path(), &a.iter().map(String::as_str).collect::<Vec<_>>());
@@ -213,4 +219,42 @@ fn a_set_resume_with_other_inputs_is_refused_naming_them() {
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
     let e = stderr(&out);
     assert!(e.contains("--resume") && e.contains("--overwrite"), "{e}");
+}
+
+#[test]
+fn a_set_saved_by_an_earlier_build_resumes_and_is_no_single_fits_checkpoint() {
+    let d = tempfile::tempdir().unwrap();
+    write_set(d.path());
+    let a = args("run");
+    let out = scenefit(d.path(), &a.iter().map(String::as_str).collect::<Vec<_>>());
+    assert!(out.status.success(), "{}", stderr(&out));
+    let done = outcome(&d.path().join("run"));
+    // One photograph's fit resumed from a set's checkpoint: one line
+    // saying what the directory holds.
+    let single = [
+        "fit",
+        "scene.json",
+        "--target",
+        "a.png",
+        "-o",
+        "run",
+        "--resume",
+    ];
+    let out = scenefit(d.path(), &single);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(stderr(&out).contains("a set's fit"), "{}", stderr(&out));
+    assert_eq!(stderr(&out).trim().lines().count(), 1, "{}", stderr(&out));
+    // An earlier build saved the same state, format 2, as set_state.json.
+    let run = d.path().join("run");
+    let mut state = json(&run.join("checkpoint.json"));
+    state["format"] = "scenefit-set-state/2".into();
+    state.as_object_mut().unwrap().remove("last_shared");
+    std::fs::write(run.join("set_state.json"), state.to_string()).unwrap();
+    std::fs::remove_file(run.join("checkpoint.json")).unwrap();
+    let mut b = a.clone();
+    b.push("--resume".into());
+    let out = scenefit(d.path(), &b.iter().map(String::as_str).collect::<Vec<_>>());
+    assert!(out.status.success(), "{}", stderr(&out));
+    let again = outcome(&run);
+    assert_eq!(again[..3], done[..3]);
 }

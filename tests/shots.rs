@@ -153,7 +153,7 @@ fn a_set_fit_recovers_the_shared_material_and_every_photographs_light() {
 fn the_joint_step_lowers_what_a_short_block_descent_leaves() {
     // Block descent on a tiny budget stops well short of the truth; the
     // joint Levenberg–Marquardt block after it (the last entry of
-    // set_state.json's history) must take most of the rest, moving shared
+    // checkpoint.json's history) must take most of the rest, moving shared
     // and per-shot values together.
     let dir = tempfile::tempdir().unwrap();
     let c = effects_data::case("none", 1, 1.0, 3, 0.0);
@@ -175,7 +175,7 @@ fn the_joint_step_lowers_what_a_short_block_descent_leaves() {
         "--quiet",
     ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let state = read_json(&out.join("set_state.json"));
+    let state = read_json(&out.join("checkpoint.json"));
     // Stored bit-exact: each value's IEEE-754 bits.
     let bits: Vec<u64> = serde_json::from_value(state["history"].clone()).unwrap();
     let history: Vec<f64> = bits.into_iter().map(f64::from_bits).collect();

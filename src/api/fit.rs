@@ -19,7 +19,7 @@ use std::path::{Path, PathBuf};
 pub struct Photographs {
     pub shots: Vec<Shot>,
     /// The shots file they were read from (a set's run directory: its
-    /// `set_state.json`, `shots.json`, one best image each), or None for
+    /// `shots.json`, one best image each, its state in `checkpoint.json`), or None for
     /// one photograph given on its own (`checkpoint.json`, `best.png`).
     pub file: Option<PathBuf>,
 }

@@ -59,6 +59,7 @@ impl Checkpoint {
     /// relies on.
     pub fn load(dir: &RunDir) -> Result<Checkpoint> {
         let file = dir.file(CHECKPOINT).display().to_string();
+        Checkpoint::check_kind(dir, CHECKPOINT, FORMAT)?;
         let c: Checkpoint = dir.read_json(CHECKPOINT, "a scenefit checkpoint (format 2)")?;
         if c.format != FORMAT {
             return Err(Error::invalid(
@@ -79,13 +80,7 @@ impl Checkpoint {
         };
         if let Some(s) = &c.search {
             let dim = space.phase(phase).dim();
-            let ok = s.best().0.len() == dim
-                && s.population().is_none_or(|(p, f)| {
-                    p.len() == f.len()
-                        && p.iter()
-                            .all(|u| u.len() == dim && u.iter().all(|x| x.is_finite()))
-                });
-            if !ok {
+            if !Checkpoint::search_fits(s, dim) {
                 return Err(Error::invalid(
                     &file,
                     "search",
@@ -107,11 +102,60 @@ impl Checkpoint {
     pub fn check_identity(&self, dir: &RunDir, now: &RunIdentity) -> Result<()> {
         match self.identity.mismatch(now) {
             None => Ok(()),
-            Some(what) => Err(Error::Usage(format!(
-                "cannot resume the run saved in {}: {what}; resume with the same inputs and options, or start afresh with --overwrite",
-                dir.file(CHECKPOINT).display()
-            ))),
+            Some(what) => Err(Checkpoint::refuse(
+                &dir.file(CHECKPOINT).display().to_string(),
+                &what,
+            )),
         }
+    }
+
+    /// The refusal of a resume whose inputs differ (`what`) from those of
+    /// the run saved in `file`: one photograph's or a set's.
+    pub fn refuse(file: &str, what: &str) -> Error {
+        Error::Usage(format!(
+            "cannot resume the run saved in {file}: {what}; resume with the same inputs and options, or start afresh with --overwrite"
+        ))
+    }
+
+    /// Refuses the state file `name` when it was saved by the other kind
+    /// of fit (one photograph's checkpoint read for a set, or a set's for
+    /// one photograph), saying which it holds; `want` is the format this
+    /// run reads. Any other format is left to the reader's own check.
+    pub fn check_kind(dir: &RunDir, name: &str, want: &str) -> Result<()> {
+        #[derive(Deserialize)]
+        struct Head {
+            format: Option<String>,
+        }
+        let Ok(head) = dir.read_json::<Head>(name, "a scenefit checkpoint") else {
+            return Ok(());
+        };
+        let is_set = |f: &str| f.starts_with("scenefit-set-state/");
+        let holds = match head.format.as_deref() {
+            Some(f) if (is_set(f) || f == FORMAT) && is_set(f) != is_set(want) => {
+                if is_set(f) {
+                    "a set's fit (fit --shots)"
+                } else {
+                    "one photograph's fit (fit --target)"
+                }
+            }
+            _ => return Ok(()),
+        };
+        Err(Error::Usage(format!(
+            "cannot resume the run saved in {}: it holds {holds}; resume it with the inputs it was started with, or start afresh with --overwrite",
+            dir.file(name).display()
+        )))
+    }
+
+    /// True when `search` is a search over `dim` coordinates whose
+    /// population, if it has one, is finite: what a saved search must be
+    /// for a resume to continue it.
+    pub fn search_fits(search: &Searcher, dim: usize) -> bool {
+        search.best().0.len() == dim
+            && search.population().is_none_or(|(p, f)| {
+                p.len() == f.len()
+                    && p.iter()
+                        .all(|u| u.len() == dim && u.iter().all(|x| x.is_finite()))
+            })
     }
 
     /// Refuses a checkpoint whose scene declares another image size than

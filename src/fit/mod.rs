@@ -15,15 +15,16 @@ pub(crate) mod identity;
 mod observers;
 mod output;
 mod problem;
+mod search_run;
 pub mod set;
 mod target;
-mod uncertainty;
+pub(crate) mod uncertainty;
 
 pub use checkpoint::Checkpoint;
 pub use config::{FitConfig, GenerationReport};
 pub use executor::{Observer, Problem};
 pub use output::{Alternative, FitOutcome, FitResult, Population};
-pub use problem::render_seed;
+pub use problem::{counted, render_seed};
 pub use target::FitTarget;
 pub use uncertainty::{Correlation, Uncertainty};
 
@@ -33,9 +34,10 @@ use crate::optimize::{Search, Searcher, Start, StopReason, StopRule};
 use crate::render::Renderer;
 use crate::rundir::{Mode, RunDir};
 use crate::scene::{ParamSpace, Scene};
-use executor::{Executor, Halt, Offsets};
+use executor::Offsets;
 use identity::RunIdentity;
-use problem::RenderProblem;
+use problem::ShotsProblem;
+use search_run::{Logs, SearchRun};
 use std::path::Path;
 
 impl Observer for () {
@@ -97,17 +99,22 @@ pub fn run_in(
         let sub = space.phase(phase);
         let session = renderer.session(&state.base, &sub, config.jobs)?;
         if logs.is_none() {
+            // Only once the renderer has started does an overwriting run
+            // remove the earlier run's files.
+            if let (Some(d), Mode::Overwrite) = (dir, config.mode) {
+                d.clear()?;
+            }
             logs = Some(Logs::open(dir, config)?);
         }
         let mut search = match state.search.take() {
             Some(s) => s,
             None => new_search(config, &sub, &state.base, state.phase_index),
         };
-        let mut problem = RenderProblem::new(
+        let mut problem = ShotsProblem::new(
             session,
             sub.clone(),
-            state.base.clone(),
-            target,
+            vec![state.base.clone()],
+            vec![target],
             config.de.seed,
         );
         if search.evaluations() > 0 {
@@ -127,19 +134,19 @@ pub fn run_in(
             phase,
         };
         let logs_now = logs.as_mut().expect("opened above");
-        let reason = run_phase(
-            &mut problem,
-            &mut search,
-            &mut state,
+        let run = SearchRun {
             rule,
             offsets,
             config,
             dir,
-            logs_now,
-            observer,
-        )?;
+        };
+        let mut save = |s: &Searcher, seconds: f64| -> Result<()> {
+            state.elapsed_before = offsets.seconds + seconds;
+            dir.map_or(Ok(()), |d| state.save_with(d, s))
+        };
+        let reason = run.run(&mut problem, &mut search, logs_now, observer, &mut save)?;
         if state.phase_index + 1 == phases.len() || reason == StopReason::Target {
-            let failed = logs_now.failures.as_ref().map_or(0, |f| f.count);
+            let failed = logs_now.failed();
             return finish(
                 state, search, problem, &space, reason, failed, renderer, config, target, dir,
             );
@@ -154,102 +161,12 @@ pub fn run_in(
     }
 }
 
-/// The observers that write into the run directory.
-struct Logs {
-    progress: Option<observers::Progress>,
-    failures: Option<observers::Failures>,
-}
-
-impl Logs {
-    /// Opened once the renderer has started: only then does an
-    /// overwriting run remove the earlier run's files.
-    fn open(dir: Option<&RunDir>, config: &FitConfig) -> Result<Logs> {
-        let Some(dir) = dir else {
-            return Ok(Logs {
-                progress: None,
-                failures: None,
-            });
-        };
-        if config.mode == Mode::Overwrite {
-            dir.clear()?;
-        }
-        let fresh = config.mode != Mode::Resume;
-        Ok(Logs {
-            progress: Some(observers::Progress::new(dir, config.snapshot_every, fresh)?),
-            failures: Some(observers::Failures::new(dir)),
-        })
-    }
-}
-
-/// Runs one phase's search to its stop rule, saving the checkpoint after
-/// every generation.
-#[allow(clippy::too_many_arguments)]
-fn run_phase(
-    problem: &mut RenderProblem,
-    search: &mut Searcher,
-    state: &mut Checkpoint,
-    rule: StopRule,
-    offsets: Offsets,
-    config: &FitConfig,
-    dir: Option<&RunDir>,
-    logs: &mut Logs,
-    observer: &mut dyn Observer,
-) -> Result<StopReason> {
-    let mut observers: Vec<&mut dyn Observer> = Vec::new();
-    if let Some(f) = logs.failures.as_mut() {
-        observers.push(f);
-    }
-    if let Some(p) = logs.progress.as_mut() {
-        observers.push(p);
-    }
-    observers.push(observer);
-    let mut executor = Executor {
-        rule,
-        interrupt: config.interrupt.clone(),
-        observers,
-    };
-    let mut save = |s: &Searcher, seconds: f64| -> Result<()> {
-        state.elapsed_before = offsets.seconds + seconds;
-        if let Some(d) = dir {
-            state.save_with(d, s)?;
-        }
-        Ok(())
-    };
-    let halt = match executor.run(problem, search, offsets, &mut save) {
-        Ok(reason) => return Ok(reason),
-        Err(h) => h,
-    };
-    let place = match dir {
-        Some(d) => format!(
-            "the checkpoint in {} resumes the run (--resume)",
-            d.path().display()
-        ),
-        None => "nothing was saved".into(),
-    };
-    Err(match halt {
-        Halt::Error(e) => e,
-        Halt::Interrupted => Error::Run(format!("interrupted; {place}")),
-        Halt::AllFailed {
-            generation,
-            failures,
-        } => {
-            if let Some(log) = logs.failures.as_mut() {
-                log.record(&failures)?;
-            }
-            Error::Run(format!(
-                "every render of generation {generation} failed; {place}. First failure: {}",
-                failures.first().map(String::as_str).unwrap_or("?")
-            ))
-        }
-    })
-}
-
 /// The outcome of the last phase, written into the run directory.
 #[allow(clippy::too_many_arguments)]
 fn finish(
     mut state: Checkpoint,
     search: Searcher,
-    problem: RenderProblem,
+    problem: ShotsProblem,
     space: &ParamSpace,
     reason: StopReason,
     failed_renders: usize,
@@ -260,7 +177,10 @@ fn finish(
 ) -> Result<FitOutcome> {
     let sub = problem.space.clone();
     let scene = sub.scene_at(&state.base, search.best().0);
-    let image = match problem.into_best_image() {
+    let image = match problem
+        .into_best_images()
+        .and_then(|v| v.into_iter().next())
+    {
         Some(img) => img,
         None => crate::render::render_one(renderer, &scene, 0)?,
     };

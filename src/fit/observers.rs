@@ -45,10 +45,11 @@ pub struct Progress {
 }
 
 impl Progress {
-    /// A fresh run writes the header; a resumed one appends.
+    /// A fresh run writes the header; a resumed one appends (and writes
+    /// it if the run it resumes had not written the file yet).
     pub fn new(dir: &RunDir, every: usize, fresh: bool) -> Result<Progress> {
         let mut log = Appender::new(dir, PROGRESS);
-        if fresh {
+        if fresh || !dir.file(PROGRESS).exists() {
             log.line("# generation evaluations deviation_average deviation_r deviation_g deviation_b params")?;
         }
         Ok(Progress {

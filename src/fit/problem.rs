@@ -1,114 +1,177 @@
-//! The problem a fit solves: render a batch of candidates (unit-cube points
-//! of one phase's parameters over a base scene) and score each against the
-//! target, keeping the best image and why failed renders failed.
+//! The problem a fit solves, for one photograph or a set: a candidate is a
+//! unit-cube point of the parameters searched, drawn once per photograph
+//! over that photograph's base scene (its own values and `set` fields in
+//! place) and scored over all of them as one fitness. It keeps the best
+//! candidate's images and why failed renders failed.
 
 use super::executor::Problem;
 use super::FitTarget;
 use crate::metric::{deviation, residuals, Deviation};
 use crate::optimize::Evaluation;
 use crate::raster::Image;
-use crate::render::{RenderResult, RenderSession};
+use crate::render::RenderSession;
 use crate::scene::{ParamSpace, Scene};
 
-pub struct RenderProblem<'a> {
-    pub session: Box<dyn RenderSession>,
+pub struct ShotsProblem<'a> {
+    session: Box<dyn RenderSession>,
+    /// The parameters searched.
     pub space: ParamSpace,
-    pub base: Scene,
-    pub target: &'a FitTarget,
-    /// The run's seed: each generation's sampler seed is drawn from it.
+    /// Each photograph's scene with everything not searched in place.
+    pub bases: Vec<Scene>,
+    pub targets: Vec<&'a FitTarget>,
+    /// The run's (or block's) seed: each generation's sampler seed is
+    /// drawn from it.
     pub seed: u64,
-    best: Option<(f64, Image)>,
+    /// The best candidate's fitness and images, one per photograph.
+    best: Option<(f64, Vec<Image>)>,
     failures: Vec<String>,
+    failed_renders: usize,
 }
 
-impl<'a> RenderProblem<'a> {
+impl<'a> ShotsProblem<'a> {
     pub fn new(
         session: Box<dyn RenderSession>,
         space: ParamSpace,
-        base: Scene,
-        target: &'a FitTarget,
+        bases: Vec<Scene>,
+        targets: Vec<&'a FitTarget>,
         seed: u64,
     ) -> Self {
-        RenderProblem {
+        debug_assert_eq!(bases.len(), targets.len());
+        ShotsProblem {
             session,
             space,
-            base,
-            target,
+            bases,
+            targets,
             seed,
             best: None,
             failures: Vec::new(),
+            failed_renders: 0,
         }
     }
 
-    /// Renders the best point once, for its image (a resumed run).
+    /// Renders the best point once, for its images (a resumed run).
     pub fn adopt_best(&mut self, point: &[f64], fitness: f64) {
-        let scene = self.space.scene_at(&self.base, point);
-        if let Some(Ok(img)) = self
+        let scenes = self.scenes_at(point);
+        let images: Option<Vec<Image>> = self
             .session
-            .render_batch(std::slice::from_ref(&scene), 0)
-            .pop()
-        {
-            self.best = Some((fitness, img));
+            .render_batch(&scenes, 0)
+            .into_iter()
+            .map(|r| r.ok())
+            .collect();
+        if let Some(images) = images.filter(|v| v.len() == scenes.len()) {
+            self.best = Some((fitness, images));
         }
     }
 
-    pub fn into_best_image(self) -> Option<Image> {
-        self.best.map(|(_, img)| img)
+    /// The best candidate's images, one per photograph.
+    pub fn into_best_images(self) -> Option<Vec<Image>> {
+        self.best.map(|(_, images)| images)
     }
 
-    fn score(&mut self, i: usize, generation: usize, r: RenderResult, want: bool) -> Evaluation {
-        // After Ctrl-C the executor drops the batch: scoring what was
-        // rendered before it would only delay the exit
-        if crate::exec::cancel::is_cancelled() {
-            return Evaluation::failed();
-        }
-        let t = &self.target.image;
-        match r {
-            Ok(img) if img.dimensions() == t.dimensions() => {
-                let fitness = deviation(t, &img, self.target.mask.as_ref()).fitness();
-                let res = want.then(|| residuals(t, &img, self.target.mask.as_ref()));
-                if self.best.as_ref().is_none_or(|(f, _)| fitness < *f) {
-                    self.best = Some((fitness, img));
-                }
-                Evaluation {
-                    fitness,
-                    residuals: res,
-                }
-            }
-            Ok(img) => {
-                self.failures.push(format!(
-                    "generation {generation} candidate {i}: image is {}x{}, expected {}x{}",
+    /// Candidates that failed so far (a render crashed, hung or was wrong).
+    pub fn failed_renders(&self) -> usize {
+        self.failed_renders
+    }
+
+    fn scenes_at(&self, point: &[f64]) -> Vec<Scene> {
+        self.bases
+            .iter()
+            .map(|b| self.space.scene_at(b, point))
+            .collect()
+    }
+
+    fn fail(&mut self, i: usize, generation: usize, why: String) -> Evaluation {
+        self.failed_renders += 1;
+        self.failures
+            .push(format!("generation {generation} candidate {i}: {why}"));
+        Evaluation::failed()
+    }
+
+    /// Scores one candidate's images (one per photograph): the deviation
+    /// over every counted pixel of every photograph, as one fitness.
+    fn score(&mut self, i: usize, generation: usize, images: Vec<Image>, want: bool) -> Evaluation {
+        let mut res = Vec::new();
+        let mut parts = Vec::with_capacity(images.len());
+        for (img, t) in images.iter().zip(&self.targets) {
+            if img.dimensions() != t.image.dimensions() {
+                let why = format!(
+                    "image is {}x{}, expected {}x{}",
                     img.width(),
                     img.height(),
-                    t.width(),
-                    t.height()
-                ));
-                Evaluation::failed()
+                    t.image.width(),
+                    t.image.height()
+                );
+                return self.fail(i, generation, why);
             }
-            Err(f) => {
-                self.failures
-                    .push(format!("generation {generation} candidate {i}: {f}"));
-                Evaluation::failed()
+            parts.push((deviation(&t.image, img, t.mask.as_ref()), counted(t)));
+            if want {
+                res.extend(residuals(&t.image, img, t.mask.as_ref()));
             }
+        }
+        let fitness = over(&parts).fitness();
+        if self.best.as_ref().is_none_or(|(f, _)| fitness < *f) {
+            self.best = Some((fitness, images));
+        }
+        Evaluation {
+            fitness,
+            residuals: want.then_some(res),
         }
     }
 }
 
-impl Problem for RenderProblem<'_> {
+/// The deviation over every photograph: one photograph's own, exactly
+/// (the pooled weights of one part would round it), or the pooled one.
+pub fn over(parts: &[(Deviation, usize)]) -> Deviation {
+    match parts {
+        [(d, _)] => *d,
+        _ => Deviation::pooled(parts),
+    }
+}
+
+/// Pixels of a target that count.
+pub fn counted(t: &FitTarget) -> usize {
+    t.mask
+        .as_ref()
+        .map_or((t.image.width() * t.image.height()) as usize, |m| {
+            m.pixels().len()
+        })
+}
+
+impl Problem for ShotsProblem<'_> {
     fn evaluate(&mut self, points: &[Vec<f64>], want: bool, generation: usize) -> Vec<Evaluation> {
         self.failures.clear();
-        let scenes: Vec<Scene> = points
-            .iter()
-            .map(|u| self.space.scene_at(&self.base, u))
-            .collect();
-        let images = self
+        let n = self.bases.len();
+        let scenes: Vec<Scene> = points.iter().flat_map(|u| self.scenes_at(u)).collect();
+        let mut rendered = self
             .session
-            .render_batch(&scenes, render_seed(self.seed, generation));
-        images
-            .into_iter()
-            .enumerate()
-            .map(|(i, r)| self.score(i, generation, r, want))
-            .collect()
+            .render_batch(&scenes, render_seed(self.seed, generation))
+            .into_iter();
+        let mut out = Vec::with_capacity(points.len());
+        for i in 0..points.len() {
+            let mut images = Vec::with_capacity(n);
+            let mut failed = None;
+            for s in 0..n {
+                // A set names the photograph; one photograph needs no name.
+                let shot = if n > 1 {
+                    format!("shot {s}: ")
+                } else {
+                    String::new()
+                };
+                match rendered.next() {
+                    Some(Ok(img)) => images.push(img),
+                    Some(Err(f)) => failed = failed.or(Some(format!("{shot}{f}"))),
+                    None => failed = failed.or(Some(format!("{shot}no image"))),
+                }
+            }
+            // After Ctrl-C the executor drops the batch: scoring what was
+            // rendered before it would only delay the exit.
+            out.push(match failed {
+                _ if crate::exec::cancel::is_cancelled() => Evaluation::failed(),
+                Some(why) => self.fail(i, generation, why),
+                None => self.score(i, generation, images, want),
+            });
+        }
+        out
     }
 
     fn failures(&self) -> &[String] {
@@ -116,19 +179,24 @@ impl Problem for RenderProblem<'_> {
     }
 
     fn best_image(&self) -> Option<&Image> {
-        self.best.as_ref().map(|(_, img)| img)
+        self.best.as_ref().and_then(|(_, v)| v.first())
     }
 
     fn params(&self, point: &[f64]) -> serde_json::Map<String, serde_json::Value> {
         self.space
-            .json_values(&self.space.scene_at(&self.base, point))
+            .json_values(&self.space.scene_at(&self.bases[0], point))
     }
 
     fn best_deviation(&self) -> Deviation {
-        self.best
-            .as_ref()
-            .map(|(_, img)| deviation(&self.target.image, img, self.target.mask.as_ref()))
-            .unwrap_or_default()
+        let Some((_, images)) = &self.best else {
+            return Deviation::default();
+        };
+        let parts: Vec<(Deviation, usize)> = images
+            .iter()
+            .zip(&self.targets)
+            .map(|(img, t)| (deviation(&t.image, img, t.mask.as_ref()), counted(t)))
+            .collect();
+        over(&parts)
     }
 }
 

@@ -11,8 +11,9 @@ use serde::{Deserialize, Serialize};
 
 use super::{exact, sampling};
 
-const TAU1: f64 = 0.1;
-const TAU2: f64 = 0.1;
+/// tau1 and tau2 of Brest et al., both 0.1 there: the chance that an
+/// individual resamples its F, and (apart) its CR.
+const TAU: f64 = 0.1;
 /// F is resampled as `F_LOWER + rand * F_SPAN`, i.e. in [0.1, 1.0].
 const F_LOWER: f64 = 0.1;
 const F_SPAN: f64 = 0.9;
@@ -39,12 +40,12 @@ impl JdeState {
 
     /// The F and CR individual `i` uses for its next trial.
     pub fn propose<R: Rng>(&self, i: usize, rng: &mut R) -> (f64, f64) {
-        let f = if sampling::unit(rng) < TAU1 {
+        let f = if sampling::unit(rng) < TAU {
             F_LOWER + sampling::unit(rng) * F_SPAN
         } else {
             self.f[i]
         };
-        let cr = if sampling::unit(rng) < TAU2 {
+        let cr = if sampling::unit(rng) < TAU {
             sampling::unit(rng)
         } else {
             self.cr[i]
@@ -99,12 +100,12 @@ mod tests {
         }
         let share = |k: usize| k as f64 / n as f64;
         assert!(
-            (share(new_f) - TAU1).abs() < 0.01,
+            (share(new_f) - TAU).abs() < 0.01,
             "F resampled {}",
             share(new_f)
         );
         assert!(
-            (share(new_cr) - TAU2).abs() < 0.01,
+            (share(new_cr) - TAU).abs() < 0.01,
             "CR resampled {}",
             share(new_cr)
         );

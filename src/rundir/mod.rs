@@ -38,11 +38,12 @@ pub const CHECKPOINT: &str = "checkpoint.json";
 pub const FAILURES: &str = "failures.log";
 /// trace.tsv: one line per generation with its time (the report's axis).
 pub const TRACE: &str = "trace.tsv";
-/// A pipeline's copy of the target, and of the mask when one was given.
-/// A set fit's state between blocks (see `fit::set`).
+/// A set fit's state as earlier builds saved it (now in `CHECKPOINT`):
+/// still resumed, and removed by `--overwrite`.
 pub const SET_STATE: &str = "set_state.json";
 /// A set fit's photographs, with absolute paths.
 pub const SHOTS: &str = "shots.json";
+/// A pipeline's copy of the target, and of the mask when one was given.
 pub const TARGET: &str = "target.png";
 pub const MASK: &str = "mask.png";
 /// A pipeline's stage 2: the scene handed over, and its first render.
@@ -301,7 +302,7 @@ impl RunDir {
         let (states, stage1): (&[&str], bool) = match self.kind {
             Kind::Fit => (&[CHECKPOINT], false),
             Kind::Pipeline => (&[CHECKPOINT], true),
-            Kind::Set => (&[SET_STATE], false),
+            Kind::Set => (&[CHECKPOINT, SET_STATE], false),
             Kind::Named(_) => (&[], false),
         };
         let stage1 = stage1 && self.path.join(STAGE1).join(CHECKPOINT).is_file();

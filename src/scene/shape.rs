@@ -41,6 +41,25 @@ pub enum Shape {
     },
 }
 
+/// The arms of [`Shape::fields`] and [`Shape::fields_mut`], written once:
+/// `$one` makes one number a slice of one (`from_ref` or `from_mut`).
+macro_rules! numeric_fields {
+    ($shape:expr, $one:path) => {
+        match $shape {
+            Shape::Sphere { center, radius } => vec![("center", center), ("radius", $one(radius))],
+            Shape::Plane { point, normal } => vec![("point", point), ("normal", normal)],
+            Shape::Quad {
+                corner,
+                edge_u,
+                edge_v,
+            } => vec![("corner", corner), ("edge_u", edge_u), ("edge_v", edge_v)],
+            Shape::Box { min, max } => vec![("min", min), ("max", max)],
+            // placed by the object's transform, which holds its numbers
+            Shape::Mesh { .. } => vec![],
+        }
+    };
+}
+
 impl Shape {
     /// The JSON `"type"` of the shape.
     pub fn type_name(&self) -> &'static str {
@@ -56,37 +75,12 @@ impl Shape {
     /// The shape's numeric fields, by name, in the file's order: one
     /// number (a slice of one) or a 3-vector.
     pub fn fields(&self) -> Vec<(&'static str, &[f64])> {
-        match self {
-            Shape::Sphere { center, radius } => {
-                vec![("center", center), ("radius", std::slice::from_ref(radius))]
-            }
-            Shape::Plane { point, normal } => vec![("point", point), ("normal", normal)],
-            Shape::Quad {
-                corner,
-                edge_u,
-                edge_v,
-            } => vec![("corner", corner), ("edge_u", edge_u), ("edge_v", edge_v)],
-            Shape::Box { min, max } => vec![("min", min), ("max", max)],
-            // placed by the object's transform, which holds its numbers
-            Shape::Mesh { .. } => vec![],
-        }
+        numeric_fields!(self, std::slice::from_ref)
     }
 
     /// [`Shape::fields`], writable.
     pub fn fields_mut(&mut self) -> Vec<(&'static str, &mut [f64])> {
-        match self {
-            Shape::Sphere { center, radius } => {
-                vec![("center", center), ("radius", std::slice::from_mut(radius))]
-            }
-            Shape::Plane { point, normal } => vec![("point", point), ("normal", normal)],
-            Shape::Quad {
-                corner,
-                edge_u,
-                edge_v,
-            } => vec![("corner", corner), ("edge_u", edge_u), ("edge_v", edge_v)],
-            Shape::Box { min, max } => vec![("min", min), ("max", max)],
-            Shape::Mesh { .. } => vec![],
-        }
+        numeric_fields!(self, std::slice::from_mut)
     }
 
     /// Refuses values the types cannot rule out (a negative radius, a

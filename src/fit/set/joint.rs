@@ -12,11 +12,11 @@
 //! The normal equations are summed per photograph (`lm::normal_equations`)
 //! into one small dense system (~100 coordinates for 24 photographs).
 
-use super::problem::counted;
 use super::shots::Shot;
 use super::state::SetState;
 use super::{block_seed, varying, SetConfig};
 use crate::error::{Error, Result};
+use crate::fit::counted;
 use crate::fit::render_seed;
 use crate::metric::{residuals, Deviation};
 use crate::optimize::lm::{self, Column, Normal};

@@ -25,27 +25,27 @@
 
 mod joint;
 mod outcome;
-mod problem;
 pub mod renders;
 mod setup;
 pub mod shots;
 mod state;
 
 pub use super::output::ShotResult;
+pub use crate::fit::counted;
 pub use outcome::{SetOutcome, ShotOutcome};
-pub use problem::counted;
 pub use setup::SetConfig;
 
-use super::executor::{Executor, Halt, Offsets};
+use super::executor::{Halt, Offsets};
+use super::search_run::{halt_error, Logs, SearchRun};
 use super::{FitConfig, Observer};
 use crate::error::{Error, Result};
+use crate::fit::problem::ShotsProblem;
 use crate::fit::set::shots::Shot;
 use crate::metric::Deviation;
 use crate::optimize::{Search, Searcher, Start, StopRule};
 use crate::render::Renderer;
 use crate::rundir::{Kind, Mode, RunDir};
 use crate::scene::{ParamSpace, Scene};
-use problem::SetProblem;
 use setup::{block_seed, varying};
 use state::{SetState, Within};
 use std::path::Path;
@@ -133,6 +133,7 @@ pub fn run_in(
     let started = Instant::now();
     let before = state.seconds;
     let mut cleared = config.fit.mode != Mode::Overwrite;
+    let mut logs = None;
     let mut save = |state: &mut SetState| -> Result<()> {
         state.seconds = before + started.elapsed().as_secs_f64();
         dir.map_or(Ok(()), |d| state.save(d))
@@ -156,6 +157,7 @@ pub fn run_in(
         let mut steps = Steps {
             clear: &mut clear,
             save: &mut save,
+            logs: &mut logs,
         };
         let total = match block {
             Block::Own => own_block(&mut state, shots, renderer, config, &space, dir, &mut steps)?,
@@ -183,6 +185,8 @@ pub fn run_in(
 struct Steps<'a> {
     clear: &'a mut dyn FnMut() -> Result<()>,
     save: &'a mut dyn FnMut(&mut SetState) -> Result<()>,
+    /// progress.txt and failures.log, opened by the first shared block.
+    logs: &'a mut Option<Logs>,
 }
 
 /// A step of the alternation.
@@ -282,7 +286,7 @@ fn own_block(
         .parts()
         .into_iter()
         .zip(shots)
-        .map(|(d, s)| (d, problem::counted(&s.target)))
+        .map(|(d, s)| (d, crate::fit::counted(&s.target)))
         .collect();
     Ok(Deviation::pooled(&parts).average)
 }
@@ -341,11 +345,11 @@ fn shared_block(
             own.scene_at(&s.scene, &state.own[i])
         })
         .collect();
-    let mut session = renderer.session(&bases[0], &varying(space, shots), config.fit.jobs)?;
+    let session = renderer.session(&bases[0], &varying(space, shots), config.fit.jobs)?;
     (steps.clear)()?;
     let targets = shots.iter().map(|s| &s.target).collect();
     let seed = block_seed(config.fit.de.seed, state.blocks_done, 0);
-    let mut problem = SetProblem::new(session.as_mut(), shared.clone(), bases, targets, seed);
+    let mut problem = ShotsProblem::new(session, shared.clone(), bases, targets, seed);
     let cfg = block_config(&config.fit, shared.dim(), seed);
     // A fresh fit's first shared block searches the whole box (the current
     // values one member of its population): the scene's values are a guess.
@@ -360,57 +364,42 @@ fn shared_block(
         s.set_periods(crate::fit::periods(&shared));
         s
     });
-    let mut executor = Executor {
+    let run = SearchRun {
         rule: StopRule {
             max_generations: cfg.generations,
             target: cfg.target_deviation.map(|d| 3.0 * d),
             stagnation: cfg.stagnation,
         },
-        interrupt: config.fit.interrupt.clone(),
-        observers: vec![observer],
+        offsets: Offsets {
+            generations: state.generations,
+            evaluations: state.evaluations,
+            seconds: state.seconds,
+            total_generations: state.generations + config.fit.generations,
+            phase: 1,
+        },
+        config: &config.fit,
+        dir,
     };
-    let offsets = Offsets {
-        generations: state.generations,
-        evaluations: state.evaluations,
-        seconds: state.seconds,
-        total_generations: state.generations + config.fit.generations,
-        phase: 1,
-    };
+    if search.evaluations() > 0 {
+        let (best, f) = search.best();
+        problem.adopt_best(best, f);
+    }
+    if steps.logs.is_none() {
+        *steps.logs = Some(Logs::open(dir, &config.fit)?);
+    }
+    let logs = steps.logs.as_mut().expect("opened above");
     let mut save = |s: &Searcher, _: f64| -> Result<()> {
         state.within.search = Some(s.clone());
         (steps.save)(state)
     };
-    let halted = executor.run(&mut problem, &mut search, offsets, &mut save);
-    if let Err(h) = halted {
-        return Err(halt_error(h, dir));
-    }
+    run.run(&mut problem, &mut search, logs, observer, &mut save)?;
     let n = shots.len();
     state.failed_renders += problem.failed_renders();
     state.shared = search.best().0.to_vec();
     state.evaluations += search.evaluations() * n;
     state.generations += search.generation();
     state.shared_blocks += 1;
-    Ok(search.best().1 / 3.0)
-}
-
-/// A block that stopped without a result, as the error the user sees.
-fn halt_error(h: Halt, dir: Option<&RunDir>) -> Error {
-    let place = match dir {
-        Some(d) => format!(
-            "{} resumes the run where it stopped (--resume)",
-            d.path().display()
-        ),
-        None => "nothing was saved".into(),
-    };
-    match h {
-        Halt::Error(e) => e,
-        Halt::Interrupted => Error::Run(format!("interrupted; {place}")),
-        Halt::AllFailed {
-            generation,
-            failures,
-        } => Error::Run(format!(
-            "every render of generation {generation} failed; {place}. First failure: {}",
-            failures.first().map(String::as_str).unwrap_or("?")
-        )),
-    }
+    let average = search.best().1 / 3.0;
+    state.last_shared = Some(search);
+    Ok(average)
 }

@@ -5,8 +5,9 @@
 //! absolute paths, for `diagnose`).
 
 use super::state::SetState;
-use super::{problem::counted, varying, SetConfig, ShotResult};
+use super::{varying, SetConfig, ShotResult};
 use crate::error::{Error, Result};
+use crate::fit::counted;
 use crate::fit::set::shots::{Shot, ShotsFile, FORMAT};
 use crate::fit::{render_seed, FitResult};
 use crate::metric::{deviation, deviation_levels, Deviation};
@@ -75,7 +76,7 @@ pub fn finish(
         target: None,
         target_encoding: None,
         failed_renders: state.failed_renders,
-        identifiability: None,
+        identifiability: identifiability(state, &shared, config),
         shots: Some(outs.iter().map(|o| o.result.clone()).collect()),
         alternatives: Vec::new(),
     };
@@ -89,6 +90,22 @@ pub fn finish(
         write(d, &outcome, shots)?;
     }
     Ok(outcome)
+}
+
+/// The standard errors of the shared parameters from the last shared
+/// block's local search (`--strategy hybrid`), each photograph's own
+/// values held at theirs then. None after a joint block, which moves the
+/// shared values on from where that Jacobian was taken.
+fn identifiability(
+    state: &SetState,
+    shared: &ParamSpace,
+    config: &SetConfig,
+) -> Option<crate::fit::Uncertainty> {
+    if config.joint {
+        return None;
+    }
+    let id = state.last_shared.as_ref()?.identifiability()?;
+    Some(crate::fit::uncertainty::of(shared, &id))
 }
 
 /// Every photograph rendered once at its final values, and scored.

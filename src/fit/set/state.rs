@@ -1,4 +1,5 @@
-//! A set fit's state, saved (`set_state.json`) when the run starts, after
+//! A set fit's state, saved (checkpoint.json, the file a single fit's
+//! checkpoint has) when the run starts, after
 //! every photograph of a per-shot block and every generation of a shared
 //! block, so that `--resume` continues where the run stopped and ends
 //! where an uninterrupted run ends: a photograph's fit cut short is redone
@@ -6,7 +7,8 @@
 //! Every `f64` a later block reads is stored bit-exactly
 //! (`optimize::exact`): a value off by one ulp would send the resumed run
 //! elsewhere. It records what defines the run (one identity per
-//! photograph) and refuses a resume with other inputs.
+//! photograph) and refuses a resume with other inputs. A set run saved
+//! by an earlier build (`set_state.json`, format 2) still resumes.
 
 use super::SetConfig;
 use crate::error::{Error, Result};
@@ -15,12 +17,15 @@ use crate::fit::set::shots::Shot;
 use crate::metric::Deviation;
 use crate::optimize::{exact, Searcher};
 use crate::render::Renderer;
-use crate::rundir::{RunDir, SET_STATE};
+use crate::rundir::{RunDir, CHECKPOINT, SET_STATE};
 use crate::scene::{ParamSpace, Scene};
 use serde::{Deserialize, Serialize};
 
-/// Format 2: values bit-exact, and the progress within a block.
-const FORMAT: &str = "scenefit-set-state/2";
+/// Format 3: format 2 (values bit-exact, the progress within a block)
+/// and the last shared block's search, saved as checkpoint.json.
+pub const FORMAT: &str = "scenefit-set-state/3";
+/// Format 2, saved as set_state.json by earlier builds: still resumed.
+const FORMAT_2: &str = "scenefit-set-state/2";
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct SetState {
@@ -46,6 +51,10 @@ pub struct SetState {
     pub seconds: f64,
     /// What of the block in progress is done.
     pub within: Within,
+    /// The last finished shared block's search: its standard errors
+    /// (result.json's `identifiability`).
+    #[serde(default)]
+    pub last_shared: Option<Searcher>,
 }
 
 /// The progress within the block in progress (empty between blocks).
@@ -105,6 +114,7 @@ impl SetState {
             failed_renders: 0,
             seconds: 0.0,
             within: Within::default(),
+            last_shared: None,
         }
     }
 
@@ -118,18 +128,16 @@ impl SetState {
         config: &SetConfig,
         space: &ParamSpace,
     ) -> Result<SetState> {
-        let file = dir.file(SET_STATE).display().to_string();
-        let s: SetState = dir.read_json(SET_STATE, "a scenefit set state")?;
+        let name = saved_in(dir);
+        let file = dir.file(name).display().to_string();
+        crate::fit::Checkpoint::check_kind(dir, name, FORMAT)?;
+        let s: SetState = dir.read_json(name, "a scenefit set state")?;
         let bad = |key: &str, what: &str| Error::invalid(&file, key, what);
-        if s.format != FORMAT {
+        if s.format != FORMAT && !(name == SET_STATE && s.format == FORMAT_2) {
             return Err(bad("format", &format!("expected \"{FORMAT}\"")));
         }
         let now = identities(shots, renderer, config);
-        let refuse = |what: String| {
-            Error::Usage(format!(
-                "cannot resume the run saved in {file}: {what}; resume with the same inputs and options, or start afresh with --overwrite"
-            ))
-        };
+        let refuse = |what: String| crate::fit::Checkpoint::refuse(&file, &what);
         if s.identities.len() != now.len() {
             return Err(refuse(format!(
                 "the shots file listed {} photographs, now {}",
@@ -171,7 +179,7 @@ impl SetState {
     }
 
     pub fn save(&self, dir: &RunDir) -> Result<()> {
-        dir.write_json(SET_STATE, self)
+        dir.write_json(CHECKPOINT, self)
     }
 
     /// Photograph `i`'s scene with the current shared and own values.
@@ -206,15 +214,8 @@ fn check_within(
             "expected four deviations >= 0 for each photograph fitted so far",
         ));
     }
-    let search_ok = w.search.as_ref().is_none_or(|q| {
-        use crate::optimize::Search;
-        q.best().0.len() == shared
-            && q.population().is_none_or(|(p, f)| {
-                p.len() == f.len()
-                    && p.iter()
-                        .all(|u| u.len() == shared && u.iter().all(|x| x.is_finite()))
-            })
-    });
+    let fits = |q: &Searcher| crate::fit::Checkpoint::search_fits(q, shared);
+    let search_ok = w.search.as_ref().is_none_or(fits) && s.last_shared.as_ref().is_none_or(fits);
     if !search_ok || (w.search.is_some() && !w.own_parts.is_empty()) {
         return Err((
             "within.search",
@@ -226,6 +227,16 @@ fn check_within(
         return Err(("history", "expected deviations >= 0"));
     }
     Ok(())
+}
+
+/// Where the run in `dir` saved its state: checkpoint.json, or an earlier
+/// build's set_state.json.
+fn saved_in(dir: &RunDir) -> &'static str {
+    if !dir.file(CHECKPOINT).is_file() && dir.file(SET_STATE).is_file() {
+        SET_STATE
+    } else {
+        CHECKPOINT
+    }
 }
 
 fn identities(shots: &[Shot], renderer: &dyn Renderer, config: &SetConfig) -> Vec<RunIdentity> {
