@@ -336,14 +336,17 @@ impl Geometry {
 }
 
 /// A mesh as a possible occluder of `p` (on a face of normal `face`).
-/// The tests are exact up to a margin far above rounding error: the
-/// sphere is grown, and the plane through `p` raised, by 1e-9 of the
-/// scene's scale, far below the 1e-6 that shadow rays start off their
-/// surface (`shade.rs`).
+/// Both tests are exact, with margins: the plane through `p` is raised by
+/// 1e-9 of the scene's scale (far above rounding error, far below the
+/// 1e-6 that shadow rays start off their surface, `shade.rs`, and the
+/// test takes the ray's own start); the cone is seen from `p`, not from
+/// where the ray starts, so the sphere is grown by 1e-5 besides: a ray
+/// parallel to one that misses it by that much, starting 1e-6 away,
+/// misses the sphere too.
 fn mesh_occluder(mesh: &Placed, prim: u32, p: V3, face: V3) -> Occluder {
     let (c, r) = mesh.sphere();
     let margin = 1e-9 * (1.0 + r + c.length() + p.length());
-    let r = r + margin;
+    let r = r + margin + 1e-5;
     let to = c - p;
     let d2 = to.dot(to);
     let (axis, cos_max) = if d2 > r * r {
