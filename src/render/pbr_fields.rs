@@ -45,6 +45,12 @@ pub fn distortion(scene: &Scene, backend: &str) -> Option<Refusal> {
 fn refusals(scene: &Scene, mitsuba: bool) -> Vec<Refusal> {
     let name = if mitsuba { "mitsuba" } else { "blender" };
     let mut out: Vec<Refusal> = distortion(scene, name).into_iter().collect();
+    let drawn = if mitsuba {
+        super::maps::MITSUBA
+    } else {
+        super::maps::BLENDER
+    };
+    out.extend(super::maps::refusals(scene, name, drawn));
     let c = &scene.camera;
     if mitsuba && c.kind == CameraKind::Pinhole && c.fx != c.fy {
         out.push(Refusal::new(
