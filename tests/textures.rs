@@ -304,3 +304,74 @@ fn bad_map_files_are_refused_in_one_line_naming_the_key_and_the_file() {
     let o = run(d.path(), &["render", "scene.json", "-o", "out.png"]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
 }
+
+#[path = "backends_common/mod.rs"]
+mod common;
+
+/// A floor (colour map, tiled), a ball (colour, specular and shininess
+/// maps, turned), a wall mesh (OBJ) and a panel mesh (PLY) with their own
+/// coordinates (colour map), direct light only; the maps those of
+/// scenes/textured/.
+fn agreement_scene(dir: &Path) -> std::path::PathBuf {
+    let tex = common::root().join("scenes/textured");
+    let (checker, stripes) = (tex.join("checker.png"), tex.join("stripes.png"));
+    let wall = dir.join("wall.obj");
+    std::fs::write(
+        &wall,
+        "v -1.5 0 -1.2\nv 1.5 0 -1.2\nv 1.5 1.6 -1.2\nv -1.5 1.6 -1.2\nvt 0 0\nvt 2 0\nvt 2 1\nvt 0 1\nf 1/1 2/2 3/3\nf 1/1 3/3 4/4\n",
+    )
+    .unwrap();
+    // a PLY quad on the right, facing the camera, its coordinates u v
+    let side = dir.join("side.ply");
+    std::fs::write(
+        &side,
+        "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\nproperty float u\nproperty float v\nelement face 2\nproperty list uchar int vertex_indices\nend_header\n0.7 0.1 0.3 0 0\n1.3 0.1 0.5 1 0\n1.3 1.1 0.5 1 1\n0.7 1.1 0.3 0 1\n3 0 1 2\n3 0 2 3\n",
+    )
+    .unwrap();
+    let s = json!({
+        "format": "scenefit-scene/1",
+        "image": {"width": 96, "height": 72},
+        "camera": {"type": "perspective", "position": [0.2, 1.5, 4], "look_at": [0, 0.5, 0], "fov_y_deg": 40},
+        "render": {"samples": 64, "indirect": false, "antialias": 4},
+        "lights": [{"name": "key", "type": "point", "position": [1.5, 3, 3], "intensity": 12.0}],
+        "objects": [
+            {"name": "ball", "shape": {"type": "sphere", "center": [0, 0, 0], "radius": 0.5},
+             "transform": {"rotate_deg": [0, 30, 0], "translate": [0, 0.5, 0]},
+             "material": {"color": [0.9, 0.9, 0.9], "specular": 0.4, "shininess": 30,
+                "color_map": checker, "specular_map": {"file": stripes, "scale": [2, 1]},
+                "shininess_map": {"file": stripes, "range": [5, 60]}}},
+            {"name": "floor", "shape": {"type": "plane", "point": [0, 0, 0], "normal": [0, 1, 0]},
+             "material": {"color": [0.8, 0.8, 0.8], "color_map": {"file": checker, "scale": [0.5, 0.5]}}},
+            {"name": "wall", "shape": {"type": "mesh", "file": wall},
+             "material": {"color": [0.7, 0.7, 0.7], "color_map": checker}},
+            {"name": "side", "shape": {"type": "mesh", "file": side},
+             "material": {"color": [0.9, 0.9, 0.9], "color_map": checker}}
+        ]
+    });
+    let p = dir.join("agree.json");
+    std::fs::write(&p, s.to_string()).unwrap();
+    p
+}
+
+/// Mitsuba draws the colour, specular and shininess maps of a plane, a
+/// turned sphere and meshes (OBJ and PLY) as the built-in tracer does: within 1 % over
+/// the image.
+#[test]
+fn mitsuba_draws_the_maps_as_the_built_in_tracer_does() {
+    if !common::have_mitsuba() {
+        return;
+    }
+    let d = tempfile::tempdir().unwrap();
+    let scene = api::load_scene(&agreement_scene(d.path()), &[]).unwrap();
+    let phong = api::renderer("phong", &RenderOptions::default()).unwrap();
+    let mitsuba = api::renderer("mitsuba", &RenderOptions::default()).unwrap();
+    let a = api::render(&scene, "phong", phong.as_ref(), 0).unwrap();
+    let b = api::render(&scene, "mitsuba", mitsuba.as_ref(), 7).unwrap();
+    if let Ok(out) = std::env::var("SCENEFIT_TEXTURE_IMAGES") {
+        a.save(Path::new(&out).join("phong.png")).unwrap();
+        b.save(Path::new(&out).join("mitsuba.png")).unwrap();
+    }
+    let dev = scenefit::metric::deviation(&a, &b, None);
+    eprintln!("mitsuba vs phong, textured: deviation {:.3} %", dev.average);
+    assert!(dev.average <= 1.0, "{:.3} %", dev.average);
+}

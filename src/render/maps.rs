@@ -13,7 +13,29 @@ pub const PHONG: &[MapKind] = &[MapKind::Color, MapKind::Specular, MapKind::Shin
 /// The maps POV-Ray, Blender and Mitsuba draw.
 pub const POVRAY: &[MapKind] = &[];
 pub const BLENDER: &[MapKind] = &[];
-pub const MITSUBA: &[MapKind] = &[];
+pub const MITSUBA: &[MapKind] = &[MapKind::Color, MapKind::Specular, MapKind::Shininess];
+
+/// What Mitsuba draws maps on: not a box (its `cube` mesh has texture
+/// coordinates of its own) nor glass (the `principled` BSDF).
+pub fn mitsuba_limits(scene: &Scene) -> Vec<Refusal> {
+    let mut out = Vec::new();
+    for o in scene.objects.iter().filter(|o| o.material.has_maps()) {
+        let at = format!("objects.{}", o.name);
+        if matches!(o.shape, crate::scene::Shape::Box { .. }) {
+            out.push(Refusal::new(
+                format!("{at}.shape"),
+                "texture maps on a box are drawn by phong only; use phong, or six quads",
+            ));
+        }
+        if o.material.transmission > 0.0 {
+            out.push(Refusal::new(
+                format!("{at}.material.transmission"),
+                "texture maps on a transmitting material are drawn by phong only; use phong",
+            ));
+        }
+    }
+    out
+}
 
 /// A refusal for every map of `scene` that `backend` (drawing `drawn`)
 /// cannot draw, naming the field and the backends that draw it.
