@@ -78,6 +78,13 @@ const INPUTS: &[Input] = &[
         output: "out.png",
     },
     Input {
+        label: "render",
+        args: &["render", "st.json", "-o", "out.png"],
+        file: "c.png",
+        kind: Kind::Image,
+        output: "out.png",
+    },
+    Input {
         label: "fit",
         args: &["fit", "s.json", "--target", "t.png", "-o", "out"],
         file: "s.json",
@@ -399,7 +406,7 @@ fn crc32(bytes: &[u8]) -> u32 {
 }
 
 /// The valid inputs every case starts from: a 16x12 scene, its render as
-/// target and two photographs, masks, an albedo map, a mesh, a font, a finished
+/// target and two photographs, masks, an albedo map, a colour map, a mesh, a font, a finished
 /// fit (`run`) and a finished set fit (`setrun`).
 fn fixture() -> tempfile::TempDir {
     let d = tempfile::tempdir().unwrap();
@@ -415,6 +422,16 @@ fn fixture() -> tempfile::TempDir {
         .as_object_mut()
         .unwrap()
         .remove("albedo_map");
+    // a colour map in the object's frame (scene/texture/)
+    scene["objects"][0]["material"]["color_map"] = json!("c.png");
+    write(&p.join("st.json"), scene.to_string().as_bytes());
+    image::RgbImage::from_pixel(8, 8, image::Rgb([200, 180, 90]))
+        .save(p.join("c.png"))
+        .unwrap();
+    scene["objects"][0]["material"]
+        .as_object_mut()
+        .unwrap()
+        .remove("color_map");
     scene["objects"][0]["shape"] = json!({"type": "mesh", "file": "m.ply"});
     write(&p.join("sm.json"), scene.to_string().as_bytes());
     std::fs::copy(scenes().join("mesh_blob.ply"), p.join("m.ply")).unwrap();

@@ -95,6 +95,16 @@ materials (d = diffuse, c = color, ks = specular, n = shininess, kr = reflection
                       kr > 0: ``blendbsdf`` (weight kr) with a white mirror, the
                       scenefit_phong half scaled by 1/(1-kr) so that the mirror
                       is added as in the built-in tracer.
+  texture maps (color_map, specular_map, shininess_map; docs/scene-format.md
+                      "Textures") -> ``scenefit_phong`` (also for a diffuse-only
+                      material) holding each map as a ``bitmap`` of the file's
+                      linear values (decoded as its encoding says, range
+                      applied; raw, bilinear, repeat) looked up at scenefit's
+                      (u, v): ``to_uv`` turns Mitsuba's coordinates into them
+                      (a mapped sphere's to_world takes local z to +y, a
+                      mapped plane's axes are scenefit's e_u, e_v, an OBJ's v
+                      is flipped back) and flips v for the bitmap's rows.
+                      A map on a box or on glass is refused (render/maps.rs).
   kt > 0 (glass)   -> ``principled``: base_color d*c, metallic 0,
                       roughness (2/(n+2))^(1/4), specular level min(1, ks) (F0 = 0.08*ks, so
                       ks 0.5 <-> F0 0.04, as Blender); kt > 0: spec_trans = kt and eta = ior (Mitsuba then ignores
@@ -129,8 +139,8 @@ import sys
 import time
 
 import jsonlines
-from scene_common import (SceneError, add, apply_point, cross, describe, matmul4, mul, norm,
-                          normalize, roughness, sub)
+from scene_common import (MAP_KEYS, SceneError, add, apply_point, cross, describe, matmul4, mul, norm,
+                          normalize, plane_axes, roughness, sub)
 
 LLVM19 = "/usr/lib/x86_64-linux-gnu/libLLVM-19.so"
 PLANE_HALF_SIZE = 1000.0
@@ -188,12 +198,16 @@ def material_plan(m):
     kr, kt = m["kr"], m["kt"]
     if m["kind"] == "lambertian":
         return {"kind": ("lambert",), "albedo": albedo}
+    if m["maps"] and m["kind"] != "phong":
+        raise SceneError("texture maps on a transmitting material are not drawn by mitsuba; use phong")
     if m["kind"] == "phong":
         # The built-in tracer adds kr * L(mirror); a blend (1-kr) A + kr B
         # adds it too when A is scaled by 1/(1-kr) (kr capped below 1).
         mirror = min(max(kr, 0.0), 0.999)
         return {
-            "kind": ("phong", kr > 0.0),
+            # the maps (files and settings) are part of what is built
+            "kind": ("phong", kr > 0.0, repr(sorted(m["maps"].items()))),
+            "maps": m["maps"], "n2_own": m["n2_own"],
             "albedo": albedo,
             "ks": max(m["ks"], 0.0), "n": m["n"], "ks2": max(m["ks2"], 0.0), "n2": m["n2"],
             "f0": m["f0"],
@@ -274,20 +288,37 @@ def object_plan(o):
     sh, where = o["shape"], "objects.%s.shape" % o["name"]
     stype = sh["type"]
     ob = {"name": o["name"], "shape": stype, "material": material_plan(o["material"])}
+    mapped = bool(o["material"]["maps"])
+    # Mitsuba's (u, v) -> scenefit's (src/scene/texture/uv.rs), as 2x3 rows
+    ob["material"]["uv"] = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0))
     if stype == "sphere":
         c, r = sh["center"], sh["radius"]
-        ob["to_world"] = columns_matrix((r, 0, 0), (0, r, 0), (0, 0, r), c)
+        if mapped:
+            # local z to +y and local y to -z: Mitsuba's longitude
+            # atan2(y, x) and colatitude from z become ours
+            ob["to_world"] = columns_matrix((r, 0, 0), (0, 0, -r), (0, r, 0), c)
+            ob["material"]["uv"] = ((1.0, 0.0, 0.0), (0.0, -1.0, 1.0))
+        else:
+            ob["to_world"] = columns_matrix((r, 0, 0), (0, r, 0), (0, 0, r), c)
     elif stype == "plane":
         n = normalize(sh["normal"], where + ".normal")
-        u, v = basis(n)
+        u, v = plane_axes(n) if mapped else basis(n)
         ob["to_world"] = columns_matrix(mul(u, PLANE_HALF_SIZE), mul(v, PLANE_HALF_SIZE), n, sh["point"])
+        # metres from `point`: local x in [-1, 1] is u_m in [0, 1]
+        h = PLANE_HALF_SIZE
+        ob["material"]["uv"] = ((2.0 * h, 0.0, -h), (0.0, 2.0 * h, -h))
     elif stype == "quad":
         c, eu, ev = sh["corner"], sh["edge_u"], sh["edge_v"]
         n = normalize(cross(eu, ev), where + ": edge_u x edge_v")
         ob["to_world"] = columns_matrix(mul(eu, 0.5), mul(ev, 0.5), n, add(c, mul(add(eu, ev), 0.5)))
     elif stype == "mesh":
         ob["file"] = sh["file"]
+        if sh["file"].lower().endswith(".obj"):
+            # Mitsuba's OBJ loader stores 1 - v (its images run v down)
+            ob["material"]["uv"] = ((1.0, 0.0, 0.0), (0.0, -1.0, 1.0))
     else:  # box
+        if mapped:
+            raise SceneError("%s: texture maps on a box are not drawn by mitsuba; use phong" % where)
         lo, hi = sh["min"], sh["max"]
         ob["center"] = mul(add(lo, hi), 0.5)
         ob["half"] = mul(sub(hi, lo), 0.5)
@@ -340,6 +371,10 @@ def register_plugins(mi, dr):
         def __init__(self, props):
             mi.BSDF.__init__(self, props)
             self.albedo = mi.Color3f(props["albedo"]) if ("albedo" in props) else mi.Color3f(0.5)
+            # texture maps (docs/scene-format.md "Textures"), static textures
+            for k in MAP_KEYS:
+                setattr(self, k, props[k] if (k in props) else None)
+            self.n2_follows = bool(props["n2_follows"]) if ("n2_follows" in props) else False
             defaults = {"ks": 0.0, "n": 10.0, "ks2": 0.0, "n2": 10.0, "f0": 1.0, "scale": 1.0}
             for k in PHONG_PARAMS:
                 setattr(self, k, mi.Float(prop(props, k, defaults[k])))
@@ -369,10 +404,19 @@ def register_plugins(mi, dr):
             nh = dr.maximum(h.z, 0.0)
             hv = dr.clip(dr.dot(h, wi), 0.0, 1.0)
             norm = 1.0 / (8.0 * dr.pi)
-            lobe = (self.ks * (self.n + 8.0) * norm * dr.power(nh, self.n)
-                    + self.ks2 * (self.n2 + 8.0) * norm * dr.power(nh, self.n2))
+            albedo, ks, ks2, n, n2 = self.albedo, self.ks, self.ks2, self.n, self.n2
+            if self.color_map is not None:
+                albedo = albedo * self.color_map.eval(si)
+            if self.specular_map is not None:
+                k = self.specular_map.eval(si).x
+                ks, ks2 = ks * k, ks2 * k
+            if self.shininess_map is not None:
+                n = self.shininess_map.eval(si).x
+                n2 = n if self.n2_follows else n2
+            lobe = (ks * (n + 8.0) * norm * dr.power(nh, n)
+                    + ks2 * (n2 + 8.0) * norm * dr.power(nh, n2))
             fresnel = (self.f0 + (1.0 - self.f0) * dr.power(1.0 - hv, 5.0)) / self.f0
-            value = (self.albedo * dr.inv_pi + lobe * fresnel) * (self.scale * wo.z)
+            value = (albedo * dr.inv_pi + lobe * fresnel) * (self.scale * wo.z)
             return dr.select(ok, value, 0.0), ok
 
         def eval(self, ctx, si, wo, active=True):
@@ -569,6 +613,9 @@ class MitsubaBackend:
             b = {"type": "scenefit_phong", "albedo": self.rgb(m["albedo"])}
             for k in PHONG_PARAMS:
                 b[k] = m[k]
+            for key, t in m["maps"].items():
+                b[key] = self.texture(t, m["uv"], key)
+            b["n2_follows"] = not m["n2_own"]
             if kind[1]:
                 b = {"type": "blendbsdf", "weight": m["mirror"], "bsdf_0": b,
                      "bsdf_1": {"type": "conductor", "material": "none"}}
@@ -588,6 +635,27 @@ class MitsubaBackend:
         if not has_trans:
             b = {"type": "twosided", "bsdf": b}
         return b
+
+    def texture(self, t, uv, key):
+        """A map as a ``bitmap`` of linear values (the file decoded as its
+        encoding says, then ``range`` applied), bilinear, repeated, looked
+        up at scenefit's (u, v) (``uv``: from Mitsuba's) times ``scale``,
+        v up (Mitsuba's bitmap has its first row at v = 0)."""
+        mi = self.mi
+        try:
+            bmp = mi.Bitmap(t["file"])
+        except Exception as e:
+            raise SceneError("%s: cannot read %s: %s" % (key, t["file"], str(e).strip()))
+        bmp.set_srgb_gamma(t["encoding"] == "srgb")
+        bmp = bmp.convert(mi.Bitmap.PixelFormat.RGB, mi.Struct.Type.Float32, srgb_gamma=False)
+        lo, hi = t["range"]
+        data = mi.TensorXf(bmp) * (hi - lo) + lo
+        su, sv = t["scale"]
+        flip = ((su, 0.0, 0.0), (0.0, -sv, 1.0), (0.0, 0.0, 1.0))
+        a = (uv[0], uv[1], (0.0, 0.0, 1.0))
+        m = [[sum(flip[i][k] * a[k][j] for k in range(3)) for j in range(3)] for i in range(3)]
+        return {"type": "bitmap", "data": data, "raw": True, "filter_type": "bilinear",
+                "wrap_mode": "repeat", "to_uv": mi.ScalarTransform3f(m)}
 
     def bsdf_values(self, key, m):
         """Traversed parameter keys of the BSDF built by bsdf_dict -> values."""

@@ -25,7 +25,10 @@ worker keeps its own arithmetic):
   an absolute path to a PLY or OBJ file scenefit has read and checked) and
   ``material``: the project's convention values (docs/renderers.md, "One
   material convention") and its ``kind``: lambertian (diffuse only), phong
-  (the built-in tracer's lobes) or principled (transmitting: glass).
+  (the built-in tracer's lobes, or any material with texture maps) or
+  principled (transmitting: glass); ``maps``: each texture map present
+  (``texture_map``), ``n2_own``: whether ``shininess2`` is the material's
+  own (else it follows ``shininess`` and a shininess map).
 """
 
 import math
@@ -148,9 +151,11 @@ def material(m, where):
                                 ("f0", "fresnel", 1.0)):
         v[key] = num(m.get(field, default), "%s.%s" % (where, field))
     v["n2"] = num(m.get("shininess2", v["n"]), where + ".shininess2")
+    v["n2_own"] = "shininess2" in m
+    v["maps"] = {k: texture_map(m[k], k, "%s.%s" % (where, k)) for k in MAP_KEYS if m.get(k) is not None}
     if v["kt"] != 0.0:
         v["kind"] = "principled"
-    elif v["ks"] == 0.0 and v["ks2"] == 0.0 and v["kr"] == 0.0:
+    elif v["ks"] == 0.0 and v["ks2"] == 0.0 and v["kr"] == 0.0 and not v["maps"]:
         v["kind"] = "lambertian"
         return v
     else:
@@ -164,6 +169,45 @@ def material(m, where):
     if v["kind"] == "principled" and v["ior"] <= 0.0:
         raise SceneError("%s.ior: must be > 0, got %r" % (where, v["ior"]))
     return v
+
+
+# The texture maps of a material (docs/scene-format.md, "Textures").
+MAP_KEYS = ("color_map", "specular_map", "shininess_map", "normal_map")
+
+
+def texture_map(t, key, where):
+    """A map's file and settings, its defaults resolved as scenefit does:
+    ``file``, ``encoding`` (srgb for a colour map other than OpenEXR,
+    linear otherwise), ``scale`` (u, v) and ``range`` (lo, hi)."""
+    if isinstance(t, str):
+        t = {"file": t}
+    if not isinstance(t, dict):
+        raise SceneError("%s: expected a path or an object" % where)
+    f = path(t.get("file"), where + ".file")
+    enc = t.get("encoding")
+    if enc is None:
+        enc = "srgb" if key == "color_map" and not f.lower().endswith(".exr") else "linear"
+    if enc not in ("srgb", "linear"):
+        raise SceneError("%s.encoding: expected srgb or linear, got %r" % (where, enc))
+
+    def pair(k, default):
+        v = t.get(k, default)
+        if not isinstance(v, (list, tuple)) or len(v) != 2:
+            raise SceneError("%s.%s: expected two numbers, got %r" % (where, k, v))
+        return (num(v[0], where + "." + k), num(v[1], where + "." + k))
+    return {"file": f, "encoding": enc, "scale": pair("scale", [1, 1]), "range": pair("range", [0, 1])}
+
+
+def plane_axes(n):
+    """A plane's texture axes (e_u, e_v) for its normal n: as
+    src/scene/texture/uv.rs (e_u = unit y x n, or the unit part of x
+    across n when |n_y| > 0.999; e_v = n x e_u)."""
+    n = normalize(n, "plane normal")
+    if abs(n[1]) > 0.999:
+        eu = normalize(sub((1.0, 0.0, 0.0), mul(n, n[0])), "plane e_u")
+    else:
+        eu = normalize(cross((0.0, 1.0, 0.0), n), "plane e_u")
+    return eu, cross(n, eu)
 
 
 def falloff_power(L, where):

@@ -28,6 +28,10 @@ pub const MAX_FONT_BYTES: u64 = 64 << 20;
 /// binary PLY, far below what would exhaust memory once parsed.
 pub const MAX_MESH_BYTES: u64 = 256 << 20;
 
+/// The most a texture file (PNG or OpenEXR) may hold: an 8192 x 8192
+/// 16-bit RGBA PNG stored raw is 512 MiB; real ones are far smaller.
+pub const MAX_TEXTURE_BYTES: u64 = 512 << 20;
+
 /// The most a text file of a run directory (a trace, a ledger) may hold.
 pub const MAX_TEXT_BYTES: u64 = 64 << 20;
 

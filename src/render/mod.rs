@@ -13,6 +13,7 @@ pub mod blender;
 pub mod command;
 pub mod external;
 pub mod layer;
+pub mod maps;
 pub mod mitsuba;
 pub mod near_lights;
 pub mod pbr_fields;

@@ -11,7 +11,8 @@
 //! transmitting material (glass is drawn by the principled BSDF, with its
 //! own Fresnel term and one lobe), `albedo_map` (a map in the image's
 //! frame, drawn by the built-in tracer only) and `diffuse_f90` other than 1
-//! (the built-in tracer's grazing factor of the diffuse term). `indirect_light` is the built-in
+//! (the built-in tracer's grazing factor of the diffuse term), and the
+//! texture maps either cannot draw (`maps.rs`). `indirect_light` is the built-in
 //! tracer's stand-in for what `render.indirect` traces: not refused.
 
 use super::backend::Refusal;
@@ -45,6 +46,15 @@ pub fn distortion(scene: &Scene, backend: &str) -> Option<Refusal> {
 fn refusals(scene: &Scene, mitsuba: bool) -> Vec<Refusal> {
     let name = if mitsuba { "mitsuba" } else { "blender" };
     let mut out: Vec<Refusal> = distortion(scene, name).into_iter().collect();
+    let drawn = if mitsuba {
+        super::maps::MITSUBA
+    } else {
+        super::maps::BLENDER
+    };
+    out.extend(super::maps::refusals(scene, name, drawn));
+    if mitsuba {
+        out.extend(super::maps::mitsuba_limits(scene));
+    }
     let c = &scene.camera;
     if mitsuba && c.kind == CameraKind::Pinhole && c.fx != c.fy {
         out.push(Refusal::new(

@@ -116,6 +116,7 @@ pub fn refusals(scene: &Scene) -> Vec<Refusal> {
     if let Some(r) = super::pbr_fields::distortion(scene, "povray") {
         out.push(r);
     }
+    out.extend(super::maps::refusals(scene, "povray", super::maps::POVRAY));
     for o in &scene.objects {
         let m = &o.material;
         if m.albedo_map.is_some() {

@@ -5,7 +5,7 @@
 
 use super::registry::ALL;
 use crate::scene::test_scene::ball;
-use crate::scene::{Falloff, LightKind, Scene};
+use crate::scene::{Falloff, LightKind, Scene, TextureRef};
 use std::collections::BTreeSet;
 
 /// The doc's rows: (field column, refused-by column).
@@ -48,6 +48,18 @@ fn scene_for(field: &str) -> Scene {
         "`render.max_depth` above 254" => s.render.max_depth = 255,
         "`material.diffuse_f90` (other than 1)" => m.diffuse_f90 = Some(0.5),
         "`material.albedo_map`" => m.albedo_map = Some("map.png".into()),
+        "`material.color_map`" => m.color_map = Some(TextureRef::File("t.png".into())),
+        "`material.specular_map`" => m.specular_map = Some(TextureRef::File("t.png".into())),
+        "`material.shininess_map`" => m.shininess_map = Some(TextureRef::File("t.png".into())),
+        "`material.normal_map`" => m.normal_map = Some(TextureRef::File("t.png".into())),
+        "a texture map on a `box`, or on a material with `transmission` > 0" => {
+            m.color_map = Some(TextureRef::File("t.png".into()));
+            m.transmission = 0.5;
+            s.objects[0].shape = serde_json::from_value(
+                serde_json::json!({"type": "box", "min": [0.0, 0.0, 0.0], "max": [1.0, 1.0, 1.0]}),
+            )
+            .unwrap();
+        }
         "`camera.fy` other than `camera.fx` (a pinhole's)" => {
             s.camera = serde_json::from_value(serde_json::json!({"type": "pinhole",
                 "fx": 100.0, "fy": 90.0, "cx": 31.5, "cy": 23.5, "rotation": [0.0, 0.0, 0.0],

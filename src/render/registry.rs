@@ -14,13 +14,14 @@ use crate::error::{Error, Result};
 use crate::scene::{ParamSpace, Scene};
 use std::borrow::Cow;
 
-/// The built-in tracer: draws every field (it is the model).
+/// The built-in tracer: draws every field (it is the model) but the
+/// texture maps it does not draw yet (`maps.rs`).
 const PHONG: Backend = Backend {
     name: "phong",
     arg: None,
     about: "the built-in Whitted-style tracer (the model every other backend is matched to)",
     build: |_, _| Box::new(phong::Phong),
-    supports: |_| Vec::new(),
+    supports: |s| super::maps::refusals(s, "phong", super::maps::PHONG),
 };
 
 /// Every backend, in the order help and errors list them.

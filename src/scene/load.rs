@@ -146,6 +146,8 @@ pub fn from_value(value: serde_json::Value, file: &str) -> Result<Scene> {
         let message = limits::one_line(&e.into_inner().to_string());
         let message = if message.contains("untagged enum Bound") {
             "expected a number or an array of three numbers".to_string()
+        } else if message.contains("untagged enum TextureRef") {
+            "expected an image file's path or {\"file\": PATH, \"encoding\", \"scale\", \"range\"} (docs/scene-format.md, \"Textures\")".to_string()
         } else {
             message
         };
@@ -154,6 +156,12 @@ pub fn from_value(value: serde_json::Value, file: &str) -> Result<Scene> {
     for o in &mut scene.objects {
         if let Some(p) = o.material.albedo_map.as_mut() {
             *p = super::albedo_map::resolve(p, file).display().to_string();
+        }
+        for kind in super::texture::MapKind::ALL {
+            if let Some(t) = o.material.map_mut(kind) {
+                let p = t.file_mut();
+                *p = super::albedo_map::resolve(p, file).display().to_string();
+            }
         }
         if let super::shape::Shape::Mesh { file: p } = &mut o.shape {
             *p = super::albedo_map::resolve(p, file).display().to_string();

@@ -16,6 +16,7 @@ pub mod pinhole;
 pub mod shape;
 #[cfg(test)]
 pub(crate) mod test_scene;
+pub mod texture;
 pub mod transform;
 pub mod types;
 pub mod validate;

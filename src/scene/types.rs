@@ -5,6 +5,8 @@
 use serde::{Deserialize, Serialize};
 
 pub use super::shape::Shape;
+use super::texture::MapKind;
+pub use super::texture::TextureRef;
 pub use super::transform::{Scale, Transform};
 
 pub use crate::math::Vec3;
@@ -308,6 +310,18 @@ pub struct Material {
     /// absolute when the scene is read.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub albedo_map: Option<String>,
+    /// Textures in the object's frame (`texture/`, docs/scene-format.md
+    /// "Textures"): the colour times the map, the specular strengths times
+    /// the map, the shininess replaced by the map, the normal replaced by
+    /// the map's (tangent space). Paths made absolute when the scene is read.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub color_map: Option<TextureRef>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub specular_map: Option<TextureRef>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shininess_map: Option<TextureRef>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub normal_map: Option<TextureRef>,
 }
 
 fn one() -> f64 {
@@ -324,6 +338,33 @@ impl Material {
     /// Diffuse only: the same Lambertian BSDF in every backend.
     pub fn is_lambertian(&self) -> bool {
         self.specular == 0.0 && self.reflection == 0.0 && self.transmission == 0.0
+    }
+}
+
+impl Material {
+    /// The material's map of `kind`, if it has one.
+    pub fn map(&self, kind: MapKind) -> Option<&TextureRef> {
+        match kind {
+            MapKind::Color => self.color_map.as_ref(),
+            MapKind::Specular => self.specular_map.as_ref(),
+            MapKind::Shininess => self.shininess_map.as_ref(),
+            MapKind::Normal => self.normal_map.as_ref(),
+        }
+    }
+
+    /// [`Material::map`], writable.
+    pub fn map_mut(&mut self, kind: MapKind) -> Option<&mut TextureRef> {
+        match kind {
+            MapKind::Color => self.color_map.as_mut(),
+            MapKind::Specular => self.specular_map.as_mut(),
+            MapKind::Shininess => self.shininess_map.as_mut(),
+            MapKind::Normal => self.normal_map.as_mut(),
+        }
+    }
+
+    /// True when any map is present.
+    pub fn has_maps(&self) -> bool {
+        MapKind::ALL.iter().any(|&k| self.map(k).is_some())
     }
 }
 

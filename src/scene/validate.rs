@@ -34,6 +34,7 @@ pub fn validate(scene: &Scene, file: &str) -> Result<()> {
     objects(scene, file)?;
     albedo_maps(scene, file)?;
     meshes(scene, file)?;
+    textures(scene, file)?;
     free_list(scene, file)
 }
 
@@ -45,6 +46,32 @@ fn albedo_maps(scene: &Scene, file: &str) -> Result<()> {
         if let Some(p) = &o.material.albedo_map {
             let key = format!("objects[{i}].material.albedo_map");
             super::albedo_map::check(std::path::Path::new(p), size, file, &key)?;
+        }
+    }
+    Ok(())
+}
+
+/// Every texture map (`texture/`): readable, its values in range; a
+/// mapped mesh must have texture coordinates.
+fn textures(scene: &Scene, file: &str) -> Result<()> {
+    use super::texture::MapKind;
+    for (i, o) in scene.objects.iter().enumerate() {
+        for kind in MapKind::ALL {
+            let Some(t) = o.material.map(kind) else {
+                continue;
+            };
+            let key = format!("objects[{i}].material.{}", kind.key());
+            super::texture::check(t, kind, file, &key)?;
+            if let super::shape::Shape::Mesh { file: p } = &o.shape {
+                let mesh = super::mesh::get(std::path::Path::new(p))?;
+                if mesh.texcoords.is_empty() {
+                    return Err(Error::invalid(
+                        file,
+                        key,
+                        format!("the mesh {} has no texture coordinates; expected a PLY (s, t or u, v) or OBJ (vt) file with them", quote(p)),
+                    ));
+                }
+            }
         }
     }
     Ok(())

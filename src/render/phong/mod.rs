@@ -6,7 +6,8 @@
 //!
 //! Reads from the scene: `camera`, `image`, `ambient`, `indirect_light`,
 //! `lights` (with `radius` for soft shadows and `falloff_power`), `objects`
-//! (with `fresnel`, `specular2`, `shininess2`, `albedo_map`), `render.antialias`,
+//! (with `fresnel`, `specular2`, `shininess2`, `albedo_map`, and the
+//! texture maps `color_map`, `specular_map`, `shininess_map`: `texture.rs`), `render.antialias`,
 //! `render.max_depth`. The camera's `vignetting` and `response` are applied
 //! after any renderer (render/camera_effects.rs).
 //!
@@ -25,6 +26,7 @@ mod geometry;
 mod packed;
 mod paths;
 mod shade;
+mod texture;
 mod trimesh;
 
 use super::{Image, RenderFailure, RenderResult, RenderSession, Renderer};
@@ -114,14 +116,18 @@ impl PhongSession {
             }
         }
         match &self.cached {
-            Some(p) => shade::shade(&p.paths, &p.packed, scene, &maps, &mut buf),
+            Some(p) => {
+                let tex = texture::HitMaps::new(&p.paths, &p.packed, scene)?;
+                shade::shade(&p.paths, &p.packed, scene, &maps, tex.as_ref(), &mut buf)
+            }
             None => {
                 let p = Prepared::new(scene, &self.variation, false);
                 // a cancelled build is cut short, never shaded
                 if cancel::is_cancelled() {
                     return Err(RenderFailure::new(cancel::MESSAGE));
                 }
-                shade::shade(&p.paths, &p.packed, scene, &maps, &mut buf)
+                let tex = texture::HitMaps::new(&p.paths, &p.packed, scene)?;
+                shade::shade(&p.paths, &p.packed, scene, &maps, tex.as_ref(), &mut buf)
             }
         }
         if cancel::is_cancelled() {

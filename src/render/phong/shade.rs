@@ -17,8 +17,12 @@
 //! `shininess2`), the diffuse term's grazing factor `diffuse_f90`
 //! (Burley's), the material's `albedo_map` (the diffuse and ambient
 //! terms of a camera ray's first hit times the map at its pixel; what
-//! mirrors, glass and the one-bounce estimate see is not mapped), and the
-//! scene's `indirect_light` (a one-bounce estimate).
+//! mirrors, glass and the one-bounce estimate see is not mapped), the
+//! texture maps in the object's frame (`texture.rs`: the diffuse and
+//! ambient terms times `color_map`, the specular ones times
+//! `specular_map`, the lobes' exponent from `shininess_map`; the
+//! one-bounce estimate sees the scalar colour), and the scene's
+//! `indirect_light` (a one-bounce estimate).
 //!
 //! The per-light pass over all hits is written as plain loops over arrays
 //! so that the compiler vectorises it; on CPUs with AVX2 a copy compiled for
@@ -27,6 +31,7 @@
 use super::geometry::Geometry;
 use super::packed::{LightPack, Packed};
 use super::paths::{Paths, Via, NO_PARENT};
+use super::texture::HitMaps;
 use crate::math::V3;
 use crate::render::srgb::encode_slice;
 use crate::render::RenderFailure;
@@ -109,7 +114,14 @@ thread_local! {
 }
 
 /// Renders `scene` from its cached hits into 8-bit sRGB RGB bytes.
-pub fn shade(paths: &Paths, packed: &Packed, scene: &Scene, maps: &Maps, out: &mut [u8]) {
+pub fn shade(
+    paths: &Paths,
+    packed: &Packed,
+    scene: &Scene,
+    maps: &Maps,
+    tex: Option<&HitMaps>,
+    out: &mut [u8],
+) {
     SCRATCH.with(|cell| {
         let mut guard = cell.borrow_mut();
         let Scratch { r, g, b, e, nh } = &mut *guard;
@@ -117,7 +129,7 @@ pub fn shade(paths: &Paths, packed: &Packed, scene: &Scene, maps: &Maps, out: &m
             v.clear();
             v.resize(packed.n, 0.0);
         }
-        shade_into(paths, packed, scene, maps, out, r, g, b, e, nh);
+        shade_into(paths, packed, scene, (maps, tex), out, r, g, b, e, nh);
     })
 }
 
@@ -126,7 +138,7 @@ fn shade_into(
     paths: &Paths,
     packed: &Packed,
     scene: &Scene,
-    maps: &Maps,
+    (maps, tex): (&Maps, Option<&HitMaps>),
     out: &mut [u8],
     r: &mut [f32],
     g: &mut [f32],
@@ -139,10 +151,8 @@ fn shade_into(
     // With albedo maps the specular terms are kept apart, so that only the
     // diffuse ones are mapped.
     let n = packed.n;
-    let mut specular = maps
-        .iter()
-        .any(Option::is_some)
-        .then(|| (vec![0f32; n], vec![0f32; n], vec![0f32; n]));
+    let apart = maps.iter().any(Option::is_some) || tex.is_some();
+    let mut specular = apart.then(|| (vec![0f32; n], vec![0f32; n], vec![0f32; n]));
     for (l, light) in scene.lights.iter().enumerate() {
         let lamp = lamp(light);
         if lamp.power == [0.0; 3] || cancelled() {
@@ -152,10 +162,15 @@ fn shade_into(
         if cancelled() {
             return;
         }
-        add_light(packed, &mats, &lamp, e, nh, r, g, b, specular.as_mut());
+        let lit = (&lamp, &*e, &*nh);
+        add_light(packed, &mats, lit, (scene, tex), r, g, b, specular.as_mut());
     }
-    if let Some((sr, sg, sb)) = specular {
+    if let Some((mut sr, mut sg, mut sb)) = specular {
         apply_maps(paths, packed, maps, r, g, b);
+        if let Some(t) = tex {
+            t.apply_color(r, g, b);
+            t.apply_specular(&mut sr, &mut sg, &mut sb);
+        }
         for i in 0..n {
             r[i] += sr[i];
             g[i] += sg[i];
@@ -275,9 +290,8 @@ fn apply_maps(
 fn add_light(
     packed: &Packed,
     mats: &[Mat],
-    lamp: &Lamp,
-    e: &[f32],
-    nh: &[f32],
+    (lamp, e, nh): (&Lamp, &[f32], &[f32]),
+    (scene, tex): (&Scene, Option<&HitMaps>),
     r: &mut [f32],
     g: &mut [f32],
     b: &mut [f32],
@@ -303,7 +317,14 @@ fn add_light(
             Some((sr, sg, sb)) => (&mut sr[..], &mut sg[..], &mut sb[..]),
             None => (&mut *r, &mut *g, &mut *b),
         };
-        if m.general_specular() {
+        if let Some(shin) = tex
+            .filter(|t| t.maps_shininess(grp.object))
+            .and_then(|t| t.shininess.as_deref())
+        {
+            let mat = &scene.objects[grp.object as usize].material;
+            let light = (lamp.point, lamp.at, lamp.power);
+            super::texture::specular_per_hit(packed, range, mat, shin, light, e, r, g, b);
+        } else if m.general_specular() {
             let lobes = super::effects::Lobes {
                 spec: m.spec,
                 shininess: m.shininess,

@@ -153,6 +153,18 @@ impl TriMesh {
         Some((t, if same_side { ns } else { ng }, ng))
     }
 
+    /// The nearest hit's triangle, numbered as in the file, and its
+    /// barycentric (u, v): where a texture is looked up (`texture.rs`).
+    pub fn locate(&self, o: V3, d: V3, t_max: f64) -> Option<(usize, f64, f64)> {
+        let mut uv = (0.0, 0.0);
+        let (k, _) = self.bvh.nearest(o, d, t_max, |k, tb| {
+            let (t, u, v) = self.tris[k].hit(o, d, tb)?;
+            uv = (u, v);
+            Some(t)
+        })?;
+        Some((self.bvh.order[k] as usize, uv.0, uv.1))
+    }
+
     /// True when any triangle is hit within (EPS, t_max).
     #[inline]
     pub fn any(&self, o: V3, d: V3, t_max: f64) -> bool {
@@ -305,6 +317,12 @@ impl Placed {
                 self.mesh.reaches_above(V3::new(x, y, z), thr - b.dot(m))
             }
         }
+    }
+
+    /// [`TriMesh::locate`] for a world ray.
+    pub fn locate(&self, o: V3, d: V3, t_max: f64) -> Option<(usize, f64, f64)> {
+        let (ol, dl) = self.local(o, d)?;
+        self.mesh.locate(ol, dl, t_max)
     }
 
     #[inline]

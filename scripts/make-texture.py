@@ -1,0 +1,62 @@
+#!/usr/bin/env python3
+"""Writes the example textures of scenes/textured/ with the standard
+library alone (zlib; no image package): a colour map (a checker of two
+tints under a soft diagonal band, 8-bit RGB PNG, sRGB-encoded) and a
+specular map (vertical stripes of 1.0 and 0.25, 8-bit grey PNG, linear).
+The patterns are made by this code; nothing is downloaded.
+
+    python3 scripts/make-texture.py OUT_DIR [--size N]
+
+scenes/textured/ holds `python3 scripts/make-texture.py scenes/textured`.
+"""
+
+import argparse
+import math
+import os
+import struct
+import zlib
+
+
+def png(path, width, height, rows, channels):
+    """An 8-bit PNG (colour type 2 RGB or 0 grey) of `rows` (lists of ints)."""
+    def chunk(kind, data):
+        c = struct.pack(">I", len(data)) + kind + data
+        return c + struct.pack(">I", zlib.crc32(kind + data) & 0xFFFFFFFF)
+    kind = {3: 2, 1: 0}[channels]
+    raw = b"".join(b"\x00" + bytes(r) for r in rows)
+    data = (b"\x89PNG\r\n\x1a\n"
+            + chunk(b"IHDR", struct.pack(">IIBBBBB", width, height, 8, kind, 0, 0, 0))
+            + chunk(b"IDAT", zlib.compress(raw, 9)) + chunk(b"IEND", b""))
+    with open(path, "wb") as f:
+        f.write(data)
+
+
+def color_rows(n):
+    rows = []
+    for j in range(n):
+        row = []
+        for i in range(n):
+            check = ((i * 8 // n) + (j * 8 // n)) % 2
+            base = (230, 200, 120) if check else (90, 140, 200)
+            band = 0.75 + 0.25 * math.cos(2 * math.pi * (i + j) / n)
+            row += [int(round(c * band)) for c in base]
+        rows.append(row)
+    return rows
+
+
+def specular_rows(n):
+    return [[255 if (i * 6 // n) % 2 == 0 else 64 for i in range(n)] for _ in range(n)]
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("out")
+    ap.add_argument("--size", type=int, default=64)
+    a = ap.parse_args()
+    os.makedirs(a.out, exist_ok=True)
+    png(os.path.join(a.out, "checker.png"), a.size, a.size, color_rows(a.size), 3)
+    png(os.path.join(a.out, "stripes.png"), a.size, a.size, specular_rows(a.size), 1)
+
+
+if __name__ == "__main__":
+    main()

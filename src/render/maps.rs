@@ -1,0 +1,75 @@
+//! Which texture maps in the object's frame (`scene::texture`) each
+//! backend draws, and the refusal of the others (its `supports`), so
+//! that no backend renders another scene than the user's. The one place
+//! a backend's list of drawn maps is written.
+
+use super::backend::Refusal;
+use crate::scene::texture::MapKind;
+use crate::scene::Scene;
+
+/// The maps the built-in tracer draws (the normal map is not drawn yet).
+pub const PHONG: &[MapKind] = &[MapKind::Color, MapKind::Specular, MapKind::Shininess];
+
+/// The maps POV-Ray, Blender and Mitsuba draw.
+pub const POVRAY: &[MapKind] = &[];
+pub const BLENDER: &[MapKind] = &[];
+pub const MITSUBA: &[MapKind] = &[MapKind::Color, MapKind::Specular, MapKind::Shininess];
+
+/// What Mitsuba draws maps on: not a box (its `cube` mesh has texture
+/// coordinates of its own) nor glass (the `principled` BSDF).
+pub fn mitsuba_limits(scene: &Scene) -> Vec<Refusal> {
+    let mut out = Vec::new();
+    for o in scene.objects.iter().filter(|o| o.material.has_maps()) {
+        let at = format!("objects.{}", o.name);
+        if matches!(o.shape, crate::scene::Shape::Box { .. }) {
+            out.push(Refusal::new(
+                format!("{at}.shape"),
+                "texture maps on a box are drawn by phong only; use phong, or six quads",
+            ));
+        }
+        if o.material.transmission > 0.0 {
+            out.push(Refusal::new(
+                format!("{at}.material.transmission"),
+                "texture maps on a transmitting material are drawn by phong only; use phong",
+            ));
+        }
+    }
+    out
+}
+
+/// A refusal for every map of `scene` that `backend` (drawing `drawn`)
+/// cannot draw, naming the field and the backends that draw it.
+pub fn refusals(scene: &Scene, backend: &str, drawn: &[MapKind]) -> Vec<Refusal> {
+    let mut out = Vec::new();
+    for o in &scene.objects {
+        for kind in MapKind::ALL {
+            if o.material.map(kind).is_none() || drawn.contains(&kind) {
+                continue;
+            }
+            let by: Vec<&str> = [
+                ("phong", PHONG),
+                ("povray", POVRAY),
+                ("blender", BLENDER),
+                ("mitsuba", MITSUBA),
+            ]
+            .iter()
+            .filter(|(_, d)| d.contains(&kind))
+            .map(|(n, _)| *n)
+            .collect();
+            let why = if by.is_empty() {
+                format!("{} is not drawn by any backend yet; remove it", kind.key())
+            } else {
+                format!(
+                    "{} is not drawn by {backend}; use {}",
+                    kind.key(),
+                    by.join(" or ")
+                )
+            };
+            out.push(Refusal::new(
+                format!("objects.{}.material.{}", o.name, kind.key()),
+                why,
+            ));
+        }
+    }
+    out
+}

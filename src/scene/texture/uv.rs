@@ -1,0 +1,181 @@
+//! Texture coordinates (u, v) of a surface point, in the object's own
+//! frame (the shape as written, before its `transform`), so that a map
+//! moves with its object. Every backend follows these exactly
+//! (docs/scene-format.md, "Textures"):
+//!
+//! - quad: (s, t) of corner + s edge_u + t edge_v, each in [0, 1];
+//! - plane: metres from `point` along e_u and e_v, where e_u = the unit
+//!   y x n, or the unit part of x across n when n is within 2.6 degrees
+//!   of ±y (|n_y| > 0.999), and e_v = n x e_u (a floor: u along +x,
+//!   v along -z; a wall facing +z: u along +x, v along +y);
+//! - sphere: longitude and latitude about +y: u = atan2(-d_z, d_x) / 2 pi
+//!   (in [0, 1)), v = 1/2 + asin(d_y) / pi, d the unit direction from the
+//!   centre (v = 1 at the +y pole);
+//! - box: each face its own [0, 1]^2, upright and unmirrored seen from
+//!   outside: +z face u along +x, -z face -x, +x face -z, -x face +z,
+//!   all with v along +y; top (+y) u along +x, v along -z; bottom (-y) u
+//!   along +x, v along +z;
+//! - mesh: the file's per-vertex texture coordinates, interpolated by the
+//!   barycentric coordinates of the point in its triangle.
+//!
+//! The map's `scale` then multiplies u and v.
+
+use crate::math::V3;
+use crate::scene::mesh::Mesh;
+use crate::scene::shape::Shape;
+
+/// A plane's texture axes (e_u, e_v) for its normal `n` (any length).
+pub fn plane_axes(n: V3) -> (V3, V3) {
+    let n = n.normalized();
+    let eu = if n.y.abs() > 0.999 {
+        let x = V3::new(1.0, 0.0, 0.0);
+        (x - n * n.dot(x)).normalized()
+    } else {
+        V3::new(0.0, 1.0, 0.0).cross(n).normalized()
+    };
+    (eu, n.cross(eu))
+}
+
+/// (u, v) of the point `p` (object frame) on a primitive `shape`; None
+/// for a mesh (its coordinates come from its triangles: [`mesh_uv`]).
+pub fn primitive_uv(shape: &Shape, p: V3) -> Option<[f64; 2]> {
+    match *shape {
+        Shape::Sphere { center, .. } => {
+            let d = (p - V3::from(center)).normalized();
+            let u = (-d.z).atan2(d.x) / (2.0 * std::f64::consts::PI);
+            Some([
+                u.rem_euclid(1.0),
+                0.5 + d.y.clamp(-1.0, 1.0).asin() / std::f64::consts::PI,
+            ])
+        }
+        Shape::Plane { point, normal } => {
+            let (eu, ev) = plane_axes(V3::from(normal));
+            let q = p - V3::from(point);
+            Some([q.dot(eu), q.dot(ev)])
+        }
+        Shape::Quad {
+            corner,
+            edge_u,
+            edge_v,
+        } => {
+            let (u, v) = (V3::from(edge_u), V3::from(edge_v));
+            let c = u.cross(v);
+            let w = c / c.dot(c);
+            let q = p - V3::from(corner);
+            Some([w.dot(q.cross(v)), w.dot(u.cross(q))])
+        }
+        Shape::Box { min, max } => Some(box_uv(V3::from(min), V3::from(max), p)),
+        Shape::Mesh { .. } => None,
+    }
+}
+
+/// A box's face nearest `p`, and (u, v) on it.
+fn box_uv(lo: V3, hi: V3, p: V3) -> [f64; 2] {
+    let d = hi - lo;
+    let f = |a: usize| (p.get(a) - lo.get(a)) / d.get(a); // 0 at min, 1 at max
+    let (x, y, z) = (f(0), f(1), f(2));
+    // the face whose plane is nearest, in metres
+    let gaps = [
+        (p.x - lo.x).abs(),
+        (hi.x - p.x).abs(),
+        (p.y - lo.y).abs(),
+        (hi.y - p.y).abs(),
+        (p.z - lo.z).abs(),
+        (hi.z - p.z).abs(),
+    ];
+    let face = (0..6)
+        .min_by(|&a, &b| gaps[a].total_cmp(&gaps[b]))
+        .unwrap_or(5);
+    match face {
+        0 => [z, y],       // -x: u along +z
+        1 => [1.0 - z, y], // +x: u along -z
+        2 => [x, z],       // -y: v along +z
+        3 => [x, 1.0 - z], // +y: v along -z
+        4 => [1.0 - x, y], // -z: u along -x
+        _ => [x, y],       // +z
+    }
+}
+
+/// (u, v) at barycentric (b1, b2) of triangle `tri` (the file's order) of
+/// `mesh`: (1 - b1 - b2) t0 + b1 t1 + b2 t2; None when the file has no
+/// texture coordinates.
+pub fn mesh_uv(mesh: &Mesh, tri: usize, b1: f64, b2: f64) -> Option<[f64; 2]> {
+    let t = mesh.triangles.get(tri)?;
+    let c = |k: usize| mesh.texcoords.get(t[k] as usize).copied();
+    let (t0, t1, t2) = (c(0)?, c(1)?, c(2)?);
+    let b0 = 1.0 - b1 - b2;
+    Some([
+        b0 * t0[0] + b1 * t1[0] + b2 * t2[0],
+        b0 * t0[1] + b1 * t1[1] + b2 * t2[1],
+    ])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn shape(json: &str) -> Shape {
+        serde_json::from_str(json).unwrap()
+    }
+
+    fn close(a: [f64; 2], b: [f64; 2]) -> bool {
+        (a[0] - b[0]).abs() < 1e-12 && (a[1] - b[1]).abs() < 1e-12
+    }
+
+    #[test]
+    fn a_quad_maps_its_corners_to_the_unit_square() {
+        let q = shape(r#"{"type":"quad","corner":[1,0,0],"edge_u":[2,0,0],"edge_v":[0,0,-3]}"#);
+        let at = |x, y, z| primitive_uv(&q, V3::new(x, y, z)).unwrap();
+        assert!(close(at(1.0, 0.0, 0.0), [0.0, 0.0]));
+        assert!(close(at(3.0, 0.0, 0.0), [1.0, 0.0]));
+        assert!(close(at(2.0, 0.0, -1.5), [0.5, 0.5]));
+    }
+
+    #[test]
+    fn a_floor_runs_u_along_x_and_v_away_from_a_camera_on_z_and_a_wall_upright() {
+        let floor = shape(r#"{"type":"plane","point":[0,0,0],"normal":[0,1,0]}"#);
+        let uv = primitive_uv(&floor, V3::new(0.5, 0.0, -2.0)).unwrap();
+        assert!(close(uv, [0.5, 2.0]), "{uv:?}");
+        let wall = shape(r#"{"type":"plane","point":[0,0,-1],"normal":[0,0,1]}"#);
+        let uv = primitive_uv(&wall, V3::new(0.5, 0.25, -1.0)).unwrap();
+        assert!(close(uv, [0.5, 0.25]), "{uv:?}");
+    }
+
+    #[test]
+    fn a_sphere_has_its_seam_at_plus_x_and_its_top_at_v_1() {
+        let s = shape(r#"{"type":"sphere","center":[0,1,0],"radius":2}"#);
+        let at = |x, y, z| primitive_uv(&s, V3::new(x, y, z)).unwrap();
+        assert!(close(at(0.0, 1.0, 2.0), [0.75, 0.5])); // facing +z
+        assert!(close(at(0.0, 1.0, -2.0), [0.25, 0.5]));
+        assert!((at(0.0, 3.0, 0.0)[1] - 1.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn every_box_face_is_upright_seen_from_outside() {
+        let b = shape(r#"{"type":"box","min":[0,0,0],"max":[1,2,4]}"#);
+        let at = |x, y, z| primitive_uv(&b, V3::new(x, y, z)).unwrap();
+        // from outside each side face, u grows to the right, v upwards
+        assert!(close(at(0.25, 0.5, 4.0), [0.25, 0.25])); // +z, right is +x
+        assert!(close(at(0.25, 0.5, 0.0), [0.75, 0.25])); // -z, right is -x
+        assert!(close(at(1.0, 0.5, 1.0), [0.75, 0.25])); // +x, right is -z
+        assert!(close(at(0.0, 0.5, 1.0), [0.25, 0.25])); // -x, right is +z
+        assert!(close(at(0.25, 2.0, 1.0), [0.25, 0.75])); // top, up is -z
+        assert!(close(at(0.25, 0.0, 1.0), [0.25, 0.25])); // bottom, up is +z
+    }
+
+    #[test]
+    fn a_mesh_point_interpolates_its_vertices_coordinates() {
+        let m = Mesh {
+            positions: vec![[0.0; 3]; 3],
+            normals: vec![],
+            texcoords: vec![[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]],
+            triangles: vec![[0, 1, 2]],
+        };
+        assert!(close(mesh_uv(&m, 0, 0.25, 0.5).unwrap(), [0.25, 0.5]));
+        let bare = Mesh {
+            texcoords: vec![],
+            ..m
+        };
+        assert!(mesh_uv(&bare, 0, 0.25, 0.5).is_none());
+    }
+}

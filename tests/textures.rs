@@ -1,0 +1,377 @@
+//! Textures in the object's frame (`material.color_map`, `specular_map`,
+//! `shininess_map`; docs/scene-format.md "Textures"), drawn by the
+//! built-in tracer: a map of ones draws as the untextured scene on a
+//! plane, a sphere, a box and a mesh; the colour map lands where the
+//! documented texture coordinates put it (a quad, and a mesh with the
+//! same coordinates, alike); the specular map scales the highlight and
+//! the shininess map sets its exponent; bad map files are refused in one
+//! line naming the key and the file, exit 2. Cheap: 64x48 renders.
+
+use scenefit::api::{self, Image, RenderOptions};
+use serde_json::{json, Value};
+use std::path::Path;
+use std::process::Command;
+
+/// A scene of one object (`shape`, `material`) in `dir`, lit by a point
+/// light and a little ambient, seen from +z; written to scene.json.
+fn scene(dir: &Path, shape: Value, material: Value, ortho: bool) -> std::path::PathBuf {
+    let camera = if ortho {
+        json!({"type": "orthographic", "position": [0, 0, 5], "look_at": [0, 0, 0], "height": 2.0})
+    } else {
+        json!({"type": "perspective", "position": [0.3, 1.4, 4], "look_at": [0, 0.3, 0], "fov_y_deg": 45})
+    };
+    let s = json!({
+        "format": "scenefit-scene/1",
+        "image": {"width": 64, "height": 48},
+        "camera": camera,
+        "ambient": [0.1, 0.1, 0.1],
+        "lights": [{"name": "key", "type": "point", "position": [1.0, 2.5, 3.0], "intensity": 8.0}],
+        "objects": [{"name": "thing", "shape": shape, "material": material}]
+    });
+    let p = dir.join("scene.json");
+    std::fs::write(&p, serde_json::to_string_pretty(&s).unwrap()).unwrap();
+    p
+}
+
+fn render(path: &Path) -> Image {
+    let scene = api::load_scene(path, &[]).unwrap();
+    let phong = api::renderer("phong", &RenderOptions::default()).unwrap();
+    api::render(&scene, "test", phong.as_ref(), 0).unwrap()
+}
+
+/// A PNG of `w` x `h` with texel (i, j) = f(i, j), 8-bit RGB.
+fn png(path: &Path, w: u32, h: u32, f: impl Fn(u32, u32) -> [u8; 3]) {
+    image::RgbImage::from_fn(w, h, |i, j| image::Rgb(f(i, j)))
+        .save(path)
+        .unwrap();
+}
+
+/// The largest difference of one channel, and the mean, in 8-bit codes.
+fn diff(a: &Image, b: &Image) -> (u8, f64) {
+    let d: Vec<u8> = a
+        .iter()
+        .zip(b.iter())
+        .map(|(x, y)| x.abs_diff(*y))
+        .collect();
+    let mean = d.iter().map(|&x| x as f64).sum::<f64>() / d.len() as f64;
+    (*d.iter().max().unwrap(), mean)
+}
+
+/// A quad of 2 x 2 m facing +z as an OBJ with texture coordinates: the
+/// quad shape's own parametrisation (corner (-1,-1,0), u along +x, v +y).
+fn quad_obj(dir: &Path) -> String {
+    let p = dir.join("quad.obj");
+    std::fs::write(
+        &p,
+        "v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nf 1/1 2/2 3/3\nf 1/1 3/3 4/4\n",
+    )
+    .unwrap();
+    p.display().to_string()
+}
+
+fn shapes(dir: &Path) -> Vec<(&'static str, Value)> {
+    let file = quad_obj(dir);
+    vec![
+        (
+            "plane",
+            json!({"type": "plane", "point": [0, 0, 0], "normal": [0, 1, 0]}),
+        ),
+        (
+            "sphere",
+            json!({"type": "sphere", "center": [0, 0.5, 0], "radius": 0.6}),
+        ),
+        (
+            "box",
+            json!({"type": "box", "min": [-0.5, 0, -0.5], "max": [0.5, 0.8, 0.5]}),
+        ),
+        ("mesh", json!({"type": "mesh", "file": file})),
+    ]
+}
+
+#[test]
+fn a_map_of_ones_draws_as_the_untextured_scene() {
+    let d = tempfile::tempdir().unwrap();
+    png(&d.path().join("ones.png"), 4, 4, |_, _| [255, 255, 255]);
+    for (name, shape) in shapes(d.path()) {
+        let plain = json!({"color": [0.7, 0.5, 0.3], "specular": 0.4, "shininess": 30});
+        let a = render(&scene(d.path(), shape.clone(), plain, false));
+        let mapped = json!({"color": [0.7, 0.5, 0.3], "specular": 0.4, "shininess": 30,
+            "color_map": "ones.png", "specular_map": "ones.png",
+            "shininess_map": {"file": "ones.png", "range": [0, 30]}});
+        let b = render(&scene(d.path(), shape, mapped, false));
+        let (max, mean) = diff(&a, &b);
+        // the specular terms are summed apart with maps: rounding only
+        assert!(max <= 1 && mean < 0.05, "{name}: max {max}, mean {mean}");
+        let lit = a.pixels().filter(|p| p.0.iter().any(|&c| c > 40)).count();
+        assert!(lit > 200, "{name}: {lit} lit pixels");
+    }
+}
+
+/// Texel quadrants: top left red, top right green, bottom left blue,
+/// bottom right white (8x8, linear), on a quad and on a mesh with the
+/// same coordinates, lit by ambient only (the image is the texture).
+#[test]
+fn the_colour_map_lands_where_the_documented_coordinates_put_it() {
+    let d = tempfile::tempdir().unwrap();
+    png(&d.path().join("q.png"), 8, 8, |i, j| match (i < 4, j < 4) {
+        (true, true) => [255, 0, 0],
+        (false, true) => [0, 255, 0],
+        (true, false) => [0, 0, 255],
+        (false, false) => [255, 255, 255],
+    });
+    let quad =
+        json!({"type": "quad", "corner": [-1, -1, 0], "edge_u": [2, 0, 0], "edge_v": [0, 2, 0]});
+    let mesh = json!({"type": "mesh", "file": quad_obj(d.path())});
+    let mut images = Vec::new();
+    for shape in [quad, mesh] {
+        let m = json!({"color": [1, 1, 1], "color_map": {"file": "q.png", "encoding": "linear"}});
+        let p = scene(d.path(), shape, m, true);
+        let mut s: Value = serde_json::from_str(&std::fs::read_to_string(&p).unwrap()).unwrap();
+        s["ambient"] = json!([1, 1, 1]);
+        s["lights"][0]["intensity"] = json!(0.0);
+        std::fs::write(&p, s.to_string()).unwrap();
+        images.push(render(&p));
+    }
+    // the quad spans 2 m of the 2 m high view: x in [8, 56) of 64
+    let at = |img: &Image, x: u32, y: u32| img.get_pixel(x, y).0;
+    for img in &images {
+        assert_eq!(at(img, 18, 10), [255, 0, 0]);
+        assert_eq!(at(img, 45, 10), [0, 255, 0]);
+        assert_eq!(at(img, 18, 37), [0, 0, 255]);
+        assert_eq!(at(img, 45, 37), [255, 255, 255]);
+    }
+    let (max, _) = diff(&images[0], &images[1]);
+    assert!(max <= 1, "quad and mesh differ by {max}");
+}
+
+#[test]
+fn the_specular_map_scales_the_highlight_and_the_shininess_map_sets_its_exponent() {
+    let d = tempfile::tempdir().unwrap();
+    png(&d.path().join("half.png"), 2, 2, |_, _| [128, 128, 128]);
+    let ball = json!({"type": "sphere", "center": [0, 0.5, 0], "radius": 0.6});
+    let m = |extra: Value| {
+        let mut m = json!({"color": [0.5, 0.5, 0.5], "specular": 0.8, "shininess": 20});
+        m.as_object_mut()
+            .unwrap()
+            .extend(extra.as_object().unwrap().clone());
+        m
+    };
+    let half = 128.0 / 255.0;
+    let scaled = render(&scene(
+        d.path(),
+        ball.clone(),
+        m(json!({"specular": 0.8 * half})),
+        false,
+    ));
+    let mapped = render(&scene(
+        d.path(),
+        ball.clone(),
+        m(json!({"specular_map": {"file": "half.png", "encoding": "linear"}})),
+        false,
+    ));
+    let (max, _) = diff(&scaled, &mapped);
+    assert!(max <= 1, "specular map vs scalar: {max}");
+    // range [0, 2 n]: the grey 128/255 means an exponent of ~n
+    let n = 60.0;
+    let exact = render(&scene(
+        d.path(),
+        ball.clone(),
+        m(json!({"shininess": n * 2.0 * half})),
+        false,
+    ));
+    let sharp =
+        json!({"shininess_map": {"file": "half.png", "encoding": "linear", "range": [0, 2.0 * n]}});
+    let mapped = render(&scene(d.path(), ball.clone(), m(sharp), false));
+    let (max, _) = diff(&exact, &mapped);
+    assert!(max <= 1, "shininess map vs scalar: {max}");
+    let plain = render(&scene(d.path(), ball, m(json!({})), false));
+    assert!(diff(&plain, &mapped).0 > 10, "the exponent changed nothing");
+}
+
+fn run(dir: &Path, args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_scenefit"))
+        .current_dir(dir)
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+/// A PNG whose header declares `w` x `h` and holds almost no pixels.
+fn png_header_only(path: &Path, w: u32, h: u32) {
+    let mut ihdr = w.to_be_bytes().to_vec();
+    ihdr.extend(h.to_be_bytes());
+    ihdr.extend([8, 2, 0, 0, 0]);
+    let mut bytes = b"\x89PNG\r\n\x1a\n".to_vec();
+    // an empty zlib stream as the image data
+    let idat = [0x78, 0x9c, 0x03, 0x00, 0x00, 0x00, 0x00, 0x01];
+    for (kind, data) in [
+        (b"IHDR", &ihdr[..]),
+        (b"IDAT", &idat[..]),
+        (b"IEND", &[][..]),
+    ] {
+        let mut body = kind.to_vec();
+        body.extend(data);
+        bytes.extend((data.len() as u32).to_be_bytes());
+        bytes.extend(&body);
+        bytes.extend(crc32(&body).to_be_bytes());
+    }
+    std::fs::write(path, bytes).unwrap();
+}
+
+fn crc32(data: &[u8]) -> u32 {
+    let mut c = !0u32;
+    for &b in data {
+        c ^= b as u32;
+        for _ in 0..8 {
+            c = if c & 1 != 0 {
+                0xEDB8_8320 ^ (c >> 1)
+            } else {
+                c >> 1
+            };
+        }
+    }
+    !c
+}
+
+#[test]
+fn bad_map_files_are_refused_in_one_line_naming_the_key_and_the_file() {
+    let d = tempfile::tempdir().unwrap();
+    std::fs::write(d.path().join("notes.png"), "not an image").unwrap();
+    png_header_only(&d.path().join("huge.png"), 100_000, 100_000);
+    std::fs::write(
+        d.path().join("bare.obj"),
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+    )
+    .unwrap();
+    png(&d.path().join("ok.png"), 2, 2, |_, _| [9, 9, 9]);
+    png(&d.path().join("zero.png"), 2, 2, |_, _| [0, 0, 0]);
+    let sphere = json!({"type": "sphere", "center": [0, 0.5, 0], "radius": 0.6});
+    let cases = [
+        (
+            sphere.clone(),
+            json!({"color_map": "missing.png"}),
+            "missing.png",
+        ),
+        (
+            sphere.clone(),
+            json!({"specular_map": "notes.png"}),
+            "could not decode",
+        ),
+        (
+            sphere.clone(),
+            json!({"color_map": "huge.png"}),
+            "100000x100000",
+        ),
+        (
+            sphere.clone(),
+            json!({"color_map": {"file": "ok.png", "tile": 2}}),
+            "expected an image file's path",
+        ),
+        (
+            json!({"type": "mesh", "file": "bare.obj"}),
+            json!({"color_map": "ok.png"}),
+            "no texture coordinates",
+        ),
+        (
+            sphere,
+            json!({"shininess_map": "zero.png"}),
+            "expected exponents above 0",
+        ),
+    ];
+    for (shape, map, expect) in cases {
+        let mut m = json!({"color": [0.5, 0.5, 0.5]});
+        m.as_object_mut()
+            .unwrap()
+            .extend(map.as_object().unwrap().clone());
+        let key = map.as_object().unwrap().keys().next().unwrap().clone();
+        scene(d.path(), shape, m, false);
+        let o = run(d.path(), &["render", "scene.json", "-o", "out.png"]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{key}: {err}");
+        assert_eq!(err.trim().lines().count(), 1, "{err}");
+        assert!(err.contains("scene.json") && err.contains(&key), "{err}");
+        assert!(err.contains(expect), "{expect}: {err}");
+        assert!(!d.path().join("out.png").exists());
+    }
+    // the same scene with a valid map renders
+    let ok = json!({"color": [0.5, 0.5, 0.5], "color_map": "ok.png"});
+    scene(
+        d.path(),
+        json!({"type": "sphere", "center": [0, 0.5, 0], "radius": 0.6}),
+        ok,
+        false,
+    );
+    let o = run(d.path(), &["render", "scene.json", "-o", "out.png"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+}
+
+#[path = "backends_common/mod.rs"]
+mod common;
+
+/// A floor (colour map, tiled), a ball (colour, specular and shininess
+/// maps, turned), a wall mesh (OBJ) and a panel mesh (PLY) with their own
+/// coordinates (colour map), direct light only; the maps those of
+/// scenes/textured/.
+fn agreement_scene(dir: &Path) -> std::path::PathBuf {
+    let tex = common::root().join("scenes/textured");
+    let (checker, stripes) = (tex.join("checker.png"), tex.join("stripes.png"));
+    let wall = dir.join("wall.obj");
+    std::fs::write(
+        &wall,
+        "v -1.5 0 -1.2\nv 1.5 0 -1.2\nv 1.5 1.6 -1.2\nv -1.5 1.6 -1.2\nvt 0 0\nvt 2 0\nvt 2 1\nvt 0 1\nf 1/1 2/2 3/3\nf 1/1 3/3 4/4\n",
+    )
+    .unwrap();
+    // a PLY quad on the right, facing the camera, its coordinates u v
+    let side = dir.join("side.ply");
+    std::fs::write(
+        &side,
+        "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\nproperty float u\nproperty float v\nelement face 2\nproperty list uchar int vertex_indices\nend_header\n0.7 0.1 0.3 0 0\n1.3 0.1 0.5 1 0\n1.3 1.1 0.5 1 1\n0.7 1.1 0.3 0 1\n3 0 1 2\n3 0 2 3\n",
+    )
+    .unwrap();
+    let s = json!({
+        "format": "scenefit-scene/1",
+        "image": {"width": 96, "height": 72},
+        "camera": {"type": "perspective", "position": [0.2, 1.5, 4], "look_at": [0, 0.5, 0], "fov_y_deg": 40},
+        "render": {"samples": 64, "indirect": false, "antialias": 4},
+        "lights": [{"name": "key", "type": "point", "position": [1.5, 3, 3], "intensity": 12.0}],
+        "objects": [
+            {"name": "ball", "shape": {"type": "sphere", "center": [0, 0, 0], "radius": 0.5},
+             "transform": {"rotate_deg": [0, 30, 0], "translate": [0, 0.5, 0]},
+             "material": {"color": [0.9, 0.9, 0.9], "specular": 0.4, "shininess": 30,
+                "color_map": checker, "specular_map": {"file": stripes, "scale": [2, 1]},
+                "shininess_map": {"file": stripes, "range": [5, 60]}}},
+            {"name": "floor", "shape": {"type": "plane", "point": [0, 0, 0], "normal": [0, 1, 0]},
+             "material": {"color": [0.8, 0.8, 0.8], "color_map": {"file": checker, "scale": [0.5, 0.5]}}},
+            {"name": "wall", "shape": {"type": "mesh", "file": wall},
+             "material": {"color": [0.7, 0.7, 0.7], "color_map": checker}},
+            {"name": "side", "shape": {"type": "mesh", "file": side},
+             "material": {"color": [0.9, 0.9, 0.9], "color_map": checker}}
+        ]
+    });
+    let p = dir.join("agree.json");
+    std::fs::write(&p, s.to_string()).unwrap();
+    p
+}
+
+/// Mitsuba draws the colour, specular and shininess maps of a plane, a
+/// turned sphere and meshes (OBJ and PLY) as the built-in tracer does: within 1 % over
+/// the image.
+#[test]
+fn mitsuba_draws_the_maps_as_the_built_in_tracer_does() {
+    if !common::have_mitsuba() {
+        return;
+    }
+    let d = tempfile::tempdir().unwrap();
+    let scene = api::load_scene(&agreement_scene(d.path()), &[]).unwrap();
+    let phong = api::renderer("phong", &RenderOptions::default()).unwrap();
+    let mitsuba = api::renderer("mitsuba", &RenderOptions::default()).unwrap();
+    let a = api::render(&scene, "phong", phong.as_ref(), 0).unwrap();
+    let b = api::render(&scene, "mitsuba", mitsuba.as_ref(), 7).unwrap();
+    if let Ok(out) = std::env::var("SCENEFIT_TEXTURE_IMAGES") {
+        a.save(Path::new(&out).join("phong.png")).unwrap();
+        b.save(Path::new(&out).join("mitsuba.png")).unwrap();
+    }
+    let dev = scenefit::metric::deviation(&a, &b, None);
+    eprintln!("mitsuba vs phong, textured: deviation {:.3} %", dev.average);
+    assert!(dev.average <= 1.0, "{:.3} %", dev.average);
+}
