@@ -268,11 +268,17 @@ impl SetRefits<'_> {
     /// first population: each starts at the centre of its box. Why: a warm
     /// refit keeps what the model had bent to absorb the effect it lacked
     /// (on the DiLiGenT set a broad specular lobe standing in for the
-    /// camera's response), and its basin with it.
+    /// camera's response), and its basin with it. A box centred on zero
+    /// puts a direction's centre at the zero vector, which is no direction
+    /// (a second directional light's): then the start is `scene` as it is,
+    /// one member of a first population still spread over the whole box.
     pub(super) fn scratch(&mut self, scene: &Scene, own: &[Params]) -> Result<SetModel> {
         let shared = ParamSpace::from_scene(scene).shared();
-        let scene = &shared.scene_at(scene, &vec![0.5; shared.dim()]);
-        let shots = shots_of(scene, self.inputs, own)?;
+        let centre = shared.scene_at(scene, &vec![0.5; shared.dim()]);
+        let (scene, shots) = match shots_of(&centre, self.inputs, own) {
+            Ok(shots) => (&centre, shots),
+            Err(_) => (scene, shots_of(scene, self.inputs, own)?),
+        };
         let config = SetConfig {
             fit: FitConfig {
                 de: DeConfig {
