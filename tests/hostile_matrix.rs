@@ -29,6 +29,9 @@ enum Kind {
     Font,
     /// A mesh shape's file (PLY).
     Mesh,
+    /// A calibration tool's text file (COLMAP's cameras.txt and
+    /// images.txt, an OpenCV YAML).
+    Text,
 }
 
 /// One file a command reads: the command line (run in a copy of the
@@ -247,6 +250,74 @@ const INPUTS: &[Input] = &[
         kind: Kind::Font,
         output: "run",
     },
+    Input {
+        label: "import-cameras --colmap",
+        args: &[
+            "import-cameras",
+            "--colmap",
+            "col",
+            "--images",
+            ".",
+            "-o",
+            "cams.json",
+            "--scene",
+            "sp.json",
+        ],
+        file: "col/cameras.txt",
+        kind: Kind::Text,
+        output: "cams.json",
+    },
+    Input {
+        label: "import-cameras --colmap",
+        args: &[
+            "import-cameras",
+            "--colmap",
+            "col",
+            "--images",
+            ".",
+            "-o",
+            "cams.json",
+            "--scene",
+            "sp.json",
+        ],
+        file: "col/images.txt",
+        kind: Kind::Text,
+        output: "cams.json",
+    },
+    Input {
+        label: "import-cameras --colmap",
+        args: &[
+            "import-cameras",
+            "--colmap",
+            "col",
+            "--images",
+            ".",
+            "-o",
+            "cams.json",
+            "--scene",
+            "sp.json",
+        ],
+        file: "p2.png",
+        kind: Kind::Image,
+        output: "cams.json",
+    },
+    Input {
+        label: "import-cameras --opencv",
+        args: &[
+            "import-cameras",
+            "--opencv",
+            "p1.yml",
+            "--images",
+            ".",
+            "-o",
+            "cams.json",
+            "--scene",
+            "sp.json",
+        ],
+        file: "p1.yml",
+        kind: Kind::Text,
+        output: "cams.json",
+    },
 ];
 
 /// Rows whose command does not read the file yet, with why: each of their
@@ -321,7 +392,7 @@ fn mkfifo(p: &Path) {
 /// an image or a font is.
 fn wrong_format(kind: Kind) -> Vec<u8> {
     match kind {
-        Kind::Json => png_header(4, 4),
+        Kind::Json | Kind::Text => png_header(4, 4),
         Kind::Image | Kind::Exr | Kind::Font | Kind::Mesh => {
             br#"{"not": "this kind of file"}"#.to_vec()
         }
@@ -341,6 +412,7 @@ fn huge_declared(kind: Kind, valid: &[u8]) -> Vec<u8> {
             .chain(&[0u8; 36])
             .copied()
             .collect(),
+        Kind::Text => huge_declared_text(valid),
         Kind::Json => {
             let mut v: Value = serde_json::from_slice(valid).unwrap();
             if set_sizes(&mut v) {
@@ -350,6 +422,22 @@ fn huge_declared(kind: Kind, valid: &[u8]) -> Vec<u8> {
             }
         }
     }
+}
+
+/// A calibration file declaring a huge image (100000 x 100000, refused
+/// against the scene's 16 x 12), or, where nothing declares a size
+/// (images.txt), a photograph whose camera id overflows.
+fn huge_declared_text(valid: &[u8]) -> Vec<u8> {
+    let text = String::from_utf8(valid.to_vec()).unwrap();
+    if text.contains("PINHOLE 16 12") {
+        text.replace("PINHOLE 16 12", "PINHOLE 100000 100000")
+    } else if text.contains("image_width") {
+        text.replace("image_width: 16", "image_width: 100000")
+            .replace("image_height: 12", "image_height: 100000")
+    } else {
+        "1 1 0 0 0 0 0 5 99999999999999999999999 p1.png\n\n".to_string()
+    }
+    .into_bytes()
 }
 
 /// Sets every `width`, `height` and `population` in `v` to 100000; true
@@ -448,6 +536,23 @@ fn fixture() -> tempfile::TempDir {
         {"name": "b", "target": "p2.png"},
     ]});
     write(&p.join("shots.json"), shots.to_string().as_bytes());
+    // A pinhole scene and the two photographs' calibrations, for
+    // import-cameras: COLMAP's half-pixel centre (8, 6) is OpenCV's (7.5, 5.5).
+    let mut pin = json(&p.join("s.json"));
+    pin["camera"] = json!({"type": "pinhole", "fx": 20.0, "fy": 20.0, "cx": 7.5, "cy": 5.5,
+        "rotation": [3.3, 0.0, 0.0], "translation": [0.0, 0.5, 5.3]});
+    write(&p.join("sp.json"), pin.to_string().as_bytes());
+    std::fs::create_dir(p.join("col")).unwrap();
+    write(
+        &p.join("col/cameras.txt"),
+        b"# one camera\n1 PINHOLE 16 12 20 20 8 6\n",
+    );
+    write(
+        &p.join("col/images.txt"),
+        b"# two photographs\n1 1 0 0 0 0.0 0.5 5.3 1 p1.png\n\n2 1 0 0 0 0.1 0.5 5.3 1 p2.png\n\n",
+    );
+    let yml = "%YAML:1.0\n---\nimage_width: 16\nimage_height: 12\ncamera_matrix: !!opencv-matrix\n   rows: 3\n   cols: 3\n   dt: d\n   data: [ 20., 0., 7.5, 0., 20., 5.5, 0., 0., 1. ]\ndistortion_coefficients: !!opencv-matrix\n   rows: 1\n   cols: 5\n   dt: d\n   data: [ 0., 0., 0., 0., 0. ]\nrvec: !!opencv-matrix\n   rows: 3\n   cols: 1\n   dt: d\n   data: [ 3.3, 0., 0. ]\ntvec: !!opencv-matrix\n   rows: 3\n   cols: 1\n   dt: d\n   data: [ 0., 0.5, 5.3 ]\n";
+    write(&p.join("p1.yml"), yml.as_bytes());
     let font = Path::new("/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf");
     let font = std::fs::read(font).unwrap_or_else(|_| huge_declared(Kind::Font, b""));
     write(&p.join("f.ttf"), &font);

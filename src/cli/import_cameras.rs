@@ -47,6 +47,7 @@ pub fn run(a: ImportCamerasArgs) -> Result<()> {
             let named = list.into_iter().map(|i| Named {
                 name: i.name,
                 camera: i.camera,
+                from: dir.join("cameras.txt"),
             });
             let inputs = vec![dir.join("cameras.txt"), dir.join("images.txt")];
             (
@@ -63,7 +64,7 @@ pub fn run(a: ImportCamerasArgs) -> Result<()> {
     };
     refuse_overwriting(&a.output, &inputs)?;
     if let Some(scene) = &a.scene {
-        same_size(&cameras, &crate::scene::load(scene)?, &source)?;
+        same_size(&cameras, &crate::scene::load(scene)?)?;
     }
     let file = shots_out::build(cameras, &a.images, &a.output, &source)?;
     let text = serde_json::to_string_pretty(&file)
@@ -99,20 +100,24 @@ fn opencv_cameras(files: &[PathBuf], images: &Path) -> Result<Vec<Named>> {
                 f.display()
             );
         }
-        out.push(Named { name, camera });
+        out.push(Named {
+            name,
+            camera,
+            from: f.clone(),
+        });
     }
     Ok(out)
 }
 
 /// Every camera calibrated for the scene's image size: intrinsics of
 /// another size would place every pixel wrong.
-fn same_size(cameras: &[Named], scene: &crate::scene::Scene, source: &str) -> Result<()> {
+fn same_size(cameras: &[Named], scene: &crate::scene::Scene) -> Result<()> {
     let want = (scene.image.width, scene.image.height);
     for c in cameras {
         if let Some(got) = c.camera.size.filter(|&s| s != want) {
             return Err(Error::Usage(format!(
-                "{source}: {}: calibrated for {}x{} pixels, the scene's image is {}x{}; expected photographs of the calibrated size",
-                crate::scene::limits::quote(&c.name), got.0, got.1, want.0, want.1
+                "{}: {}: calibrated for {}x{} pixels, the scene's image is {}x{}; expected photographs of the calibrated size",
+                c.from.display(), crate::scene::limits::quote(&c.name), got.0, got.1, want.0, want.1
             )));
         }
     }

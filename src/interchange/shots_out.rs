@@ -23,6 +23,9 @@ const EXTENSIONS: [&str; 6] = ["png", "PNG", "tif", "tiff", "bmp", "exr"];
 pub struct Named {
     pub name: String,
     pub camera: Calibrated,
+    /// The file the camera's intrinsics (and image size) were read from,
+    /// named in errors about them.
+    pub from: std::path::PathBuf,
 }
 
 /// The photograph `name` under `images`: the name itself, else its stem
