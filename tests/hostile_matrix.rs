@@ -252,51 +252,21 @@ const INPUTS: &[Input] = &[
     },
     Input {
         label: "import-cameras --colmap",
-        args: &[
-            "import-cameras",
-            "--colmap",
-            "col",
-            "--images",
-            ".",
-            "-o",
-            "cams.json",
-            "--scene",
-            "sp.json",
-        ],
+        args: IMPORT_COLMAP,
         file: "col/cameras.txt",
         kind: Kind::Text,
         output: "cams.json",
     },
     Input {
         label: "import-cameras --colmap",
-        args: &[
-            "import-cameras",
-            "--colmap",
-            "col",
-            "--images",
-            ".",
-            "-o",
-            "cams.json",
-            "--scene",
-            "sp.json",
-        ],
+        args: IMPORT_COLMAP,
         file: "col/images.txt",
         kind: Kind::Text,
         output: "cams.json",
     },
     Input {
         label: "import-cameras --colmap",
-        args: &[
-            "import-cameras",
-            "--colmap",
-            "col",
-            "--images",
-            ".",
-            "-o",
-            "cams.json",
-            "--scene",
-            "sp.json",
-        ],
+        args: IMPORT_COLMAP,
         file: "p2.png",
         kind: Kind::Image,
         output: "cams.json",
@@ -318,6 +288,20 @@ const INPUTS: &[Input] = &[
         kind: Kind::Text,
         output: "cams.json",
     },
+];
+
+/// `import-cameras` from the fixture's COLMAP model, checked against its
+/// pinhole scene.
+const IMPORT_COLMAP: &[&str] = &[
+    "import-cameras",
+    "--colmap",
+    "col",
+    "--images",
+    ".",
+    "-o",
+    "cams.json",
+    "--scene",
+    "sp.json",
 ];
 
 /// Rows whose command does not read the file yet, with why: each of their

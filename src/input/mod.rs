@@ -32,6 +32,11 @@ pub const MAX_MESH_BYTES: u64 = 256 << 20;
 /// 16-bit RGBA PNG stored raw is 512 MiB; real ones are far smaller.
 pub const MAX_TEXTURE_BYTES: u64 = 512 << 20;
 
+/// The most a calibration file (COLMAP's cameras.txt or images.txt, an
+/// OpenCV YAML) may hold: images.txt lists every 2-D point of every
+/// photograph, some hundreds of MiB for the largest reconstructions.
+pub const MAX_CALIBRATION_BYTES: u64 = 512 << 20;
+
 /// The most a text file of a run directory (a trace, a ledger) may hold.
 pub const MAX_TEXT_BYTES: u64 = 64 << 20;
 

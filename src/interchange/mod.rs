@@ -11,17 +11,12 @@ pub mod free_spec;
 pub mod opencv_yaml;
 pub mod shots_out;
 
-/// The most a calibration file (COLMAP's cameras.txt or images.txt, an
-/// OpenCV YAML) may hold: images.txt lists every 2-D point of every
-/// photograph, some hundreds of MiB for the largest reconstructions.
-pub const MAX_CALIBRATION_BYTES: u64 = 512 << 20;
-
 use crate::error::{Error, Result};
 use std::path::Path;
 
 /// The text of calibration file `path`, read through `input/` with its cap.
 pub(crate) fn read_text(path: &Path, expected: &str) -> Result<String> {
-    let bytes = crate::input::read_capped(path, MAX_CALIBRATION_BYTES)
+    let bytes = crate::input::read_capped(path, crate::input::MAX_CALIBRATION_BYTES)
         .map_err(|e| crate::input::capped_error(path, e, expected))?;
     String::from_utf8(bytes).map_err(|e| {
         Error::Usage(format!(
