@@ -445,38 +445,6 @@ fn set_sizes(v: &mut Value) -> bool {
     }
 }
 
-/// The signature and header chunk of a PNG of `w` x `h`, nothing else.
-fn png_header(w: u32, h: u32) -> Vec<u8> {
-    let mut chunk = b"IHDR".to_vec();
-    chunk.extend(w.to_be_bytes());
-    chunk.extend(h.to_be_bytes());
-    chunk.extend([8, 2, 0, 0, 0]);
-    let mut b = b"\x89PNG\r\n\x1a\n".to_vec();
-    // the header, then an empty data chunk: a decoder has read the
-    // header in full before it finds no pixels
-    for chunk in [chunk, b"IDAT".to_vec(), b"IEND".to_vec()] {
-        b.extend((chunk.len() as u32 - 4).to_be_bytes());
-        b.extend(&chunk);
-        b.extend(crc32(&chunk).to_be_bytes());
-    }
-    b
-}
-
-fn crc32(bytes: &[u8]) -> u32 {
-    let mut c = !0u32;
-    for &b in bytes {
-        c ^= b as u32;
-        for _ in 0..8 {
-            c = if c & 1 != 0 {
-                0xEDB8_8320 ^ (c >> 1)
-            } else {
-                c >> 1
-            };
-        }
-    }
-    !c
-}
-
 /// The valid inputs every case starts from: a 16x12 scene, its render as
 /// target and two photographs, masks, an albedo map, a colour map, a mesh, a font, a finished
 /// fit (`run`) and a finished set fit (`setrun`).

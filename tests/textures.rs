@@ -196,48 +196,15 @@ fn run(dir: &Path, args: &[&str]) -> std::process::Output {
         .unwrap()
 }
 
-/// A PNG whose header declares `w` x `h` and holds almost no pixels.
-fn png_header_only(path: &Path, w: u32, h: u32) {
-    let mut ihdr = w.to_be_bytes().to_vec();
-    ihdr.extend(h.to_be_bytes());
-    ihdr.extend([8, 2, 0, 0, 0]);
-    let mut bytes = b"\x89PNG\r\n\x1a\n".to_vec();
-    // an empty zlib stream as the image data
-    let idat = [0x78, 0x9c, 0x03, 0x00, 0x00, 0x00, 0x00, 0x01];
-    for (kind, data) in [
-        (b"IHDR", &ihdr[..]),
-        (b"IDAT", &idat[..]),
-        (b"IEND", &[][..]),
-    ] {
-        let mut body = kind.to_vec();
-        body.extend(data);
-        bytes.extend((data.len() as u32).to_be_bytes());
-        bytes.extend(&body);
-        bytes.extend(crc32(&body).to_be_bytes());
-    }
-    std::fs::write(path, bytes).unwrap();
-}
-
-fn crc32(data: &[u8]) -> u32 {
-    let mut c = !0u32;
-    for &b in data {
-        c ^= b as u32;
-        for _ in 0..8 {
-            c = if c & 1 != 0 {
-                0xEDB8_8320 ^ (c >> 1)
-            } else {
-                c >> 1
-            };
-        }
-    }
-    !c
-}
-
 #[test]
 fn bad_map_files_are_refused_in_one_line_naming_the_key_and_the_file() {
     let d = tempfile::tempdir().unwrap();
     std::fs::write(d.path().join("notes.png"), "not an image").unwrap();
-    png_header_only(&d.path().join("huge.png"), 100_000, 100_000);
+    std::fs::write(
+        d.path().join("huge.png"),
+        helpers::png_header(100_000, 100_000),
+    )
+    .unwrap();
     std::fs::write(
         d.path().join("bare.obj"),
         "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
@@ -307,6 +274,8 @@ fn bad_map_files_are_refused_in_one_line_naming_the_key_and_the_file() {
 
 #[path = "backends_common/mod.rs"]
 mod common;
+#[path = "common/mod.rs"]
+mod helpers;
 
 /// A floor (colour map, tiled), a ball (colour, specular and shininess
 /// maps, turned), a wall mesh (OBJ) and a panel mesh (PLY) with their own
