@@ -7,8 +7,12 @@
 
 pub mod camera;
 pub mod colmap;
+pub mod formats;
 pub mod free_spec;
+pub mod mitsuba_export;
+pub mod mitsuba_import;
 pub mod opencv_yaml;
+pub mod scene_files;
 pub mod shots_out;
 
 use crate::error::{Error, Result};
