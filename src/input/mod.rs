@@ -37,6 +37,10 @@ pub const MAX_TEXTURE_BYTES: u64 = 512 << 20;
 /// photograph, some hundreds of MiB for the largest reconstructions.
 pub const MAX_CALIBRATION_BYTES: u64 = 512 << 20;
 
+/// The most another tool's scene file (a Mitsuba 3 XML) may hold: its
+/// meshes live in files of their own, so real ones are far smaller.
+pub const MAX_SCENE_XML_BYTES: u64 = 256 << 20;
+
 /// The most a text file of a run directory (a trace, a ledger) may hold.
 pub const MAX_TEXT_BYTES: u64 = 64 << 20;
 

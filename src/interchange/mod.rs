@@ -12,6 +12,7 @@ pub mod free_spec;
 pub mod mitsuba_export;
 pub mod mitsuba_import;
 pub mod opencv_yaml;
+pub mod python_run;
 pub mod scene_files;
 pub mod shots_out;
 
