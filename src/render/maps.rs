@@ -12,19 +12,35 @@ pub const PHONG: &[MapKind] = &[MapKind::Color, MapKind::Specular, MapKind::Shin
 
 /// The maps POV-Ray, Blender and Mitsuba draw.
 pub const POVRAY: &[MapKind] = &[];
-pub const BLENDER: &[MapKind] = &[];
+pub const BLENDER: &[MapKind] = &[MapKind::Color, MapKind::Specular, MapKind::Shininess];
 pub const MITSUBA: &[MapKind] = &[MapKind::Color, MapKind::Specular, MapKind::Shininess];
 
-/// What Mitsuba draws maps on: not a box (its `cube` mesh has texture
-/// coordinates of its own) nor glass (the `principled` BSDF).
-pub fn mitsuba_limits(scene: &Scene) -> Vec<Refusal> {
+/// Every map refusal of the Blender worker (`mitsuba` false) or the
+/// Mitsuba worker: the maps it does not draw, and what it does not draw
+/// them on (`limits`).
+pub fn worker_refusals(scene: &Scene, mitsuba: bool) -> Vec<Refusal> {
+    let (name, drawn) = if mitsuba {
+        ("mitsuba", MITSUBA)
+    } else {
+        ("blender", BLENDER)
+    };
+    let mut out = refusals(scene, name, drawn);
+    out.extend(limits(scene, mitsuba));
+    out
+}
+
+/// What a worker draws maps on: not glass (Blender's and Mitsuba's
+/// principled BSDF, which takes no maps here), and for Mitsuba
+/// (`refuse_box`) not a box (its `cube` mesh has texture coordinates of
+/// its own; Blender's box template carries scenefit's per face).
+fn limits(scene: &Scene, refuse_box: bool) -> Vec<Refusal> {
     let mut out = Vec::new();
     for o in scene.objects.iter().filter(|o| o.material.has_maps()) {
         let at = format!("objects.{}", o.name);
-        if matches!(o.shape, crate::scene::Shape::Box { .. }) {
+        if refuse_box && matches!(o.shape, crate::scene::Shape::Box { .. }) {
             out.push(Refusal::new(
                 format!("{at}.shape"),
-                "texture maps on a box are drawn by phong only; use phong, or six quads",
+                "texture maps on a box are not drawn by mitsuba; use phong or blender, or six quads",
             ));
         }
         if o.material.transmission > 0.0 {

@@ -52,13 +52,16 @@ fn scene_for(field: &str) -> Scene {
         "`material.specular_map`" => m.specular_map = Some(TextureRef::File("t.png".into())),
         "`material.shininess_map`" => m.shininess_map = Some(TextureRef::File("t.png".into())),
         "`material.normal_map`" => m.normal_map = Some(TextureRef::File("t.png".into())),
-        "a texture map on a `box`, or on a material with `transmission` > 0" => {
+        "a texture map on a `box`" => {
             m.color_map = Some(TextureRef::File("t.png".into()));
-            m.transmission = 0.5;
             s.objects[0].shape = serde_json::from_value(
                 serde_json::json!({"type": "box", "min": [0.0, 0.0, 0.0], "max": [1.0, 1.0, 1.0]}),
             )
             .unwrap();
+        }
+        "a texture map on a material with `transmission` > 0" => {
+            m.color_map = Some(TextureRef::File("t.png".into()));
+            m.transmission = 0.5;
         }
         "`camera.fy` other than `camera.fx` (a pinhole's)" => {
             s.camera = serde_json::from_value(serde_json::json!({"type": "pinhole",
