@@ -335,10 +335,6 @@ fn shared_block(
         config: &config.fit,
         dir,
     };
-    if search.evaluations() > 0 {
-        let (best, f) = search.best();
-        problem.adopt_best(best, f);
-    }
     if steps.logs.is_none() {
         *steps.logs = Some(Logs::open(dir, &config.fit)?);
     }
