@@ -89,6 +89,10 @@ def tag(w, scene, desc):
             nodes = ent["nodes"]
             socket = (nodes["diffuse"].inputs["Color"] if "diffuse" in nodes
                       else nodes["principled"].inputs["Base Color"])
+            if not ent["obj"].data.uv_layers:
+                raise worker.SceneError(
+                    "objects.%s: Blender read no texture coordinates from %s (its PLY importer "
+                    "reads s, t; write them under those names, or use OBJ)" % (name, o["shape"]["file"]))
             color_map_nodes(mat, socket, o["material"]["albedo"], cmap)
 
 
@@ -114,4 +118,8 @@ def main():
 
 
 if __name__ == "__main__":
-    main()
+    try:
+        main()
+    except worker.SceneError as e:  # the user's scene: one line, exit 2
+        print("scenefit-error: %s" % e, flush=True)
+        sys.exit(1)

@@ -7,7 +7,7 @@ Run by scenefit (src/interchange/blend_import.rs):
         --python-exit-code 1 -P import_blend.py -- RESULT.json OUT_DIR STEM
 
 Writes RESULT.json = {"scene": {...}, "warnings": [...]} and, into OUT_DIR,
-one binary PLY per mesh part (STEM.NAME.ply: positions, normals, UVs, in the
+one OBJ per mesh part (STEM.NAME.obj: positions, normals, UVs, in the
 scene's frame) and a PNG for every texture image that is packed, generated
 or not a PNG/OpenEXR file (STEM.IMAGE.png). A user's error (no camera, a
 file Blender could not load) is printed as one line "scenefit-error: ...".
@@ -20,7 +20,6 @@ in one warning per kind, listing the names it concerns.
 import json
 import math
 import os
-import struct
 import sys
 
 import bpy
@@ -35,7 +34,7 @@ F0_PER_LEVEL = 0.08
 MAX_SHININESS = 1.0e4
 PRINCIPLED_UNUSED = (("Metallic", 0.0), ("Subsurface", 0.0), ("Sheen", 0.0),
                      ("Clearcoat", 0.0), ("Anisotropic", 0.0), ("Specular Tint", 0.0),
-                     ("Alpha", 1.0), ("Emission Strength", 0.0))
+                     ("Alpha", 1.0))
 
 
 def user_error(msg):
@@ -224,6 +223,8 @@ def texture_of(node, socket_name, ctx, where):
             ctx["warn"].add("texture mapping other than a UV scale not read", where)
     elif mapping is not None and not (mapping.type == "TEX_COORD" or mapping.type == "UVMAP"):
         ctx["warn"].add("texture coordinates other than the UV map not read", where)
+    if tex.interpolation != "Linear":
+        ctx["warn"].add("image interpolation other than Linear read as bilinear", where)
     if tex.extension != "REPEAT":
         ctx["warn"].add("image extension other than REPEAT read as REPEAT", where)
     return cmap
@@ -274,7 +275,9 @@ def principled(p, ctx, where):
     for key, neutral in PRINCIPLED_UNUSED:
         if key in p.inputs and (p.inputs[key].is_linked or abs(p.inputs[key].default_value - neutral) > 1e-6):
             warn.add("Principled %s not read" % key, where)
-    if "Emission" in p.inputs and p.inputs["Emission"].is_linked:
+    em = p.inputs.get("Emission")
+    if em is not None and (em.is_linked or any(x > 0 for x in em.default_value[:3])) and \
+            p.inputs["Emission Strength"].default_value > 0:
         warn.add("Principled Emission not read", where)
     if p.inputs["Normal"].is_linked:
         warn.add("normal and bump maps not read", where)
@@ -353,49 +356,50 @@ def placement(mw):
 
 
 def corners(me, tris, bake):
-    """Vertices (x y z nx ny nz [u v], scene frame) and triangles of `tris`,
-    one vertex per distinct (position, normal, uv)."""
+    """Positions, normals and UVs (scene frame) of `tris`, each listed once,
+    and per triangle corner its (position, uv, normal) indices."""
     uv_layers = [l for l in me.uv_layers if l.active_render] or list(me.uv_layers)
     uv = uv_layers[0].data if uv_layers else None
     conv = TO_SCENE if bake is None else bake @ TO_SCENE
     nconv = conv.to_3x3().inverted().transposed()
-    index, verts, faces = {}, [], []
+    lists = ([], [], [])
+    index = ({}, {}, {})
+
+    def at(k, key, value):
+        i = index[k].get(key)
+        if i is None:
+            i = index[k][key] = len(lists[k])
+            lists[k].append(value())
+        return i
+    faces = []
     for t in tris:
         face = []
         for k in range(3):
             vi, li = t.vertices[k], t.loops[k]
-            n = tuple(t.split_normals[k])
-            key = (vi, tuple(round(x, 6) for x in n), tuple(uv[li].uv) if uv else ())
-            at = index.get(key)
-            if at is None:
-                at = index[key] = len(verts)
-                p = conv @ me.vertices[vi].co
-                nn = (nconv @ Vector(n)).normalized()
-                verts.append(tuple(p) + tuple(nn) + (tuple(uv[li].uv) if uv else ()))
-            face.append(at)
+            n = tuple(round(x, 7) for x in t.split_normals[k])
+            p = at(0, vi, lambda: tuple(conv @ me.vertices[vi].co))
+            u = at(1, tuple(uv[li].uv), lambda: tuple(uv[li].uv)) if uv else None
+            m = at(2, n, lambda: tuple((nconv @ Vector(n)).normalized()))
+            face.append((p, u, m))
         faces.append(face)
-    return verts, faces, uv is not None
+    return lists, faces
 
 
-def write_ply(path, verts, faces, has_uv):
-    props = ["x", "y", "z", "nx", "ny", "nz"] + (["u", "v"] if has_uv else [])
-    head = ["ply", "format binary_little_endian 1.0", "comment written by scenefit import",
-            "element vertex %d" % len(verts)]
-    head += ["property float %s" % p for p in props]
-    head += ["element face %d" % len(faces), "property list uchar int vertex_indices", "end_header"]
-    import array
-    flat = array.array("f", [x for v in verts for x in v])
-    tri = struct.Struct("<Biii")
-    with open(path, "wb") as f:
-        f.write(("\n".join(head) + "\n").encode("ascii"))
-        f.write(flat.tobytes() if sys.byteorder == "little" else _swapped(flat))
-        f.write(b"".join(tri.pack(3, *fc) for fc in faces))
-
-
-def _swapped(a):
-    a = a.__copy__()
-    a.byteswap()
-    return a.tobytes()
+def write_obj(path, name, lists, faces):
+    """A Wavefront OBJ: v, vt, vn and triangles v/vt/vn. OBJ rather than
+    PLY: Blender's PLY importer (3.x) drops normals, its OBJ importer keeps
+    them, so the Blender backend draws smooth parts smooth."""
+    pos, uvs, nrm = lists
+    out = ["# written by scenefit import", "o " + name]
+    out += ["v %.9g %.9g %.9g" % p for p in pos]
+    out += ["vt %.9g %.9g" % u for u in uvs]
+    out += ["vn %.9g %.9g %.9g" % n for n in nrm]
+    out.append("s 1")
+    for f in faces:
+        out.append("f " + " ".join("%d/%s/%d" % (p + 1, "" if u is None else u + 1, m + 1)
+                                   for p, u, m in f))
+    with open(path, "w") as fh:
+        fh.write("\n".join(out) + "\n")
 
 
 def mesh_objects(inst, base, ctx):
@@ -419,9 +423,9 @@ def mesh_objects(inst, base, ctx):
             mat = ob.material_slots[slot].material if slot < len(ob.material_slots) else None
             name = base if len(by_slot) == 1 else "%s_%s" % (base, mat.name if mat else slot)
             name = ctx["names"].take(name)
-            verts, faces, has_uv = corners(me, tris, bake)
-            fname = "%s.%s.ply" % (ctx["stem"], name)
-            write_ply(os.path.join(ctx["dir"], fname), verts, faces, has_uv)
+            lists, faces = corners(me, tris, bake)
+            fname = "%s.%s.obj" % (ctx["stem"], name)
+            write_obj(os.path.join(ctx["dir"], fname), name, lists, faces)
             o = {"name": name, "shape": {"type": "mesh", "file": fname}, "material": material(mat, ctx)}
             if transform is not None:
                 o["transform"] = transform
@@ -468,6 +472,9 @@ def render_settings(scene, warn):
             or v.use_curve_mapping:
         warn.add("colour management other than Standard, no look, exposure 0, gamma 1 not read",
                  v.view_transform)
+    if c.pixel_filter_type != "BOX" or c.filter_width != 1.0:
+        warn.add("pixel filters other than a 1-pixel box read as one (scenefit's renders use it)",
+                 scene.name)
     if c.use_denoising or c.film_exposure != 1.0 or r.film_transparent or r.use_motion_blur:
         warn.add("denoising, film exposure, transparent film and motion blur not read", scene.name)
     out = {"samples": int(c.samples), "indirect": c.max_bounces > 0}
