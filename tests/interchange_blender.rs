@@ -268,4 +268,14 @@ fn a_file_that_is_not_a_blend_is_one_line_and_exit_2() {
     assert_eq!(err.trim().lines().count(), 1, "{err}");
     assert!(err.contains("fake.blend: not a .blend file"), "{err}");
     assert!(!d.join("s.json").exists());
+    // a .blend's signature on a truncated file: Blender's own reason
+    if have_blender() {
+        let mut bytes = b"BLENDER-v304REND".to_vec();
+        bytes.extend([0u8; 64]);
+        std::fs::write(d.join("cut.blend"), bytes).unwrap();
+        let o = scenefit(d, &["import", "cut.blend", "-o", "s.json"]);
+        assert_eq!(o.status.code(), Some(2));
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(err.contains("cut.blend: Blender cannot read it"), "{err}");
+    }
 }

@@ -72,6 +72,12 @@ pub fn run(dir: &Path, blend: Option<&Path>, script: &str, args: &[OsString]) ->
     if let Some(line) = text.lines().rev().find_map(|l| l.strip_prefix(USER_ERROR)) {
         return Err(Error::Usage(line.trim().to_string()));
     }
+    if let (Some(b), Some(why)) = (blend, unreadable(&text)) {
+        return Err(Error::Usage(format!(
+            "{}: Blender cannot read it ({why}); expected a .blend file saved by Blender",
+            b.display()
+        )));
+    }
     if ok {
         return Ok(());
     }
@@ -80,6 +86,16 @@ pub fn run(dir: &Path, blend: Option<&Path>, script: &str, args: &[OsString]) ->
     Err(Error::Run(format!(
         "Blender failed running {script}: {last}"
     )))
+}
+
+/// Blender's reason for not loading the file it was given, from its log
+/// ("Error: Failed to read blend file 'F': Missing DNA block").
+fn unreadable(log: &str) -> Option<String> {
+    let line = log
+        .lines()
+        .find(|l| l.contains("Failed to read blend file") || l.contains("Cannot read file"))?;
+    let why = line.rsplit(": ").next().unwrap_or(line).trim();
+    Some(why.to_string())
 }
 
 /// Starts `cmd` in a process group of its own and waits at most
