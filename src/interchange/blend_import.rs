@@ -21,6 +21,8 @@ const MAX_BLEND_BYTES: u64 = 8 << 30;
 pub fn import(file: &Path, out: &Path, free: &[String]) -> Result<Vec<String>> {
     check_blend(file)?;
     let (dir_out, stem) = output_place(file, out)?;
+    crate::exec::discover::find("blender", &crate::exec::discover::apt_hint("blender"))
+        .map_err(|e| Error::Usage(format!("{}: Blender reads it: {e}", file.display())))?;
     let dir = tempfile::Builder::new()
         .prefix("scenefit-import-")
         .tempdir()
