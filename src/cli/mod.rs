@@ -1,12 +1,14 @@
 //! The command line (docs/usage.md): `demo`, `render`, `fit`, `pipeline`,
-//! `diagnose`, `report`, `import-cameras`, `free`. Each subcommand lives in its own file; this one parses and dispatches,
+//! `diagnose`, `report`, `import-cameras`, `free`, `import`, `export`. Each subcommand lives in its own file; this one parses and dispatches,
 //! and turns errors into one line and an exit code.
 
 mod demo;
 mod diagnose;
 mod env;
+mod export;
 mod fit;
 mod free;
+mod import;
 mod import_cameras;
 mod numbers;
 mod pipeline;
@@ -47,6 +49,10 @@ enum Command {
     ImportCameras(import_cameras::ImportCamerasArgs),
     /// List the fields a scene offers as free parameters, or free those a glob matches.
     Free(free::FreeArgs),
+    /// Read another tool's scene (.blend) into a scene file (docs/interchange.md).
+    Import(import::ImportArgs),
+    /// Write a scene in another tool's format (--to blender) (docs/interchange.md).
+    Export(export::ExportArgs),
 }
 
 /// Runs the command line; returns the process exit code.
@@ -84,6 +90,8 @@ pub fn main() -> i32 {
         Command::Report(a) => report::run(a),
         Command::ImportCameras(a) => import_cameras::run(a),
         Command::Free(a) => free::run(a),
+        Command::Import(a) => import::run(a),
+        Command::Export(a) => export::run(a),
     };
     match result {
         Ok(()) => 0,
