@@ -83,6 +83,19 @@ Materials (per object, linked to the object's material slot)
     = (2/(shininess+2))^(1/4), Transmission = transmission, Transmission
     Roughness 0, IOR = ior; then Mix Shader (fac = reflection) with a white
     Glossy BSDF (GGX, roughness 0 = mirror).
+Texture maps (color_map, specular_map, shininess_map; docs/scene-format.md
+  "Textures", in the "phong" graph; refused on glass)
+  Each map an Image Texture (Linear = bilinear between texel centres,
+    Repeat) of a float image of the values scenefit decodes (decoded_image:
+    the sRGB curve and `range` applied here), at scenefit's (u, v) x scale
+    (Worker._uv_socket: a sphere's longitude and latitude per shading
+    point, a mapped plane turned so its local x, y are e_u, e_v, UV maps on
+    a quad, the box template (box_uvs) and a mesh, a PLY's `u v` renamed
+    `s t` for the importer: ply_with_st).  Diffuse colour = albedo x the
+    colour map; per lobe ks x the specular map's red, the exponent the
+    shininess map's red, the lobe's colour factor and roughness computed
+    from them per shading point (Worker._map_graph).  Decoded images are
+    kept for the worker's life.
 Render
   Cycles, CPU, samples = render.samples, adaptive sampling off, denoising
   off, pixel filter BOX width 1, seed = request seed (not animated), clamping
@@ -93,19 +106,22 @@ Render
 Reuse
   The built scene is kept.  If a request's scene has the same structure
   (camera type; lights by name, type and falloff kind inverse_square /
-  custom; objects by name, shape type and material kind lambertian / phong
-  / principled) as the previous one,
+  custom; objects by name, shape type, material kind lambertian / phong
+  / principled and texture maps' settings) as the previous one,
   only values are updated in place; otherwise every datablock the worker
   made is removed (bpy.data.*.remove) and the scene is rebuilt.  Cycles
   persistent data is on, so unchanged geometry (BVH) and shaders are kept
   between renders.
 """
 
+import array
 import json
 import math
 import os
+import shutil
 import struct
 import sys
+import tempfile
 import time
 import traceback
 
@@ -117,7 +133,7 @@ for _dir in (os.path.join(_HERE, "..", "workers"), _HERE):
     if _dir not in sys.path:
         sys.path.insert(0, _dir)
 import jsonlines  # noqa: E402
-from scene_common import SceneError, describe, roughness  # noqa: E402
+from scene_common import SceneError, describe, normalize, plane_axes, roughness  # noqa: E402
 
 TIMING = bool(os.environ.get("SCENEFIT_WORKER_TIMING"))
 
@@ -229,22 +245,27 @@ def structure_of(desc):
     """The part of a described scene that decides which datablocks exist."""
     return (desc["camera"]["type"],
             tuple((L["name"], L["type"], falloff_kind(L)) for L in desc["lights"]),
-            tuple((o["name"], o["shape"]["type"], o["material"]["kind"], o["shape"].get("file"))
-                  for o in desc["objects"]))
+            tuple((o["name"], o["shape"]["type"], o["material"]["kind"], o["shape"].get("file"),
+                   map_signature(o["material"])) for o in desc["objects"]))
 
 
-def import_mesh(path, name, where):
+def import_mesh(path, name, where, mapped=False):
     """The mesh file scenefit read, imported with Blender's own importer as
     one mesh in Blender's frame (the scene's y up turned to z up, as B()),
-    smooth-shaded when the file gives vertex normals."""
+    smooth-shaded when the file gives vertex normals; a mapped PLY with
+    its texture coordinates however its header names them (ply_with_st)."""
     before = set(bpy.data.objects)
+    tmp = tempfile.mkdtemp(prefix="scenefit_ply_") if mapped else None
     try:
         if path.lower().endswith(".obj"):
             bpy.ops.wm.obj_import(filepath=path, forward_axis="Y", up_axis="Z")
         else:
-            bpy.ops.import_mesh.ply(filepath=path)
+            bpy.ops.import_mesh.ply(filepath=ply_with_st(path, tmp) if mapped else path)
     except Exception as e:  # an importer reports a bad file as RuntimeError
         raise SceneError("%s: Blender could not import %s: %s" % (where, path, str(e).strip()))
+    finally:
+        if tmp is not None:
+            shutil.rmtree(tmp, ignore_errors=True)
     new = [o for o in bpy.data.objects if o not in before and o.type == "MESH"]
     if len(new) != 1:
         raise SceneError("%s: expected one mesh in %s, Blender imported %d" % (where, path, len(new)))
@@ -255,6 +276,132 @@ def import_mesh(path, name, where):
     if not me.materials:
         me.materials.append(None)
     return me
+
+
+# ---------------------------------------------------------------------------
+# texture maps (docs/scene-format.md "Textures"; drawn in the phong graph)
+# ---------------------------------------------------------------------------
+
+
+def map_signature(m):
+    """What of a material's maps decides the nodes built: every map's
+    settings, and whether shininess2 follows a shininess map."""
+    if not m["maps"]:
+        return ()
+    return (tuple(sorted((k, t["file"], t["encoding"], tuple(t["scale"]), tuple(t["range"]))
+                         for k, t in m["maps"].items())), m["n2_own"])
+
+
+def decoded_image(t, key):
+    """The map file as a float image of scenefit's decoded values: the
+    stored fractions (Non-Color: no colour management, 8 and 16 bits
+    alike), through the sRGB curve when the encoding says so, then
+    ``range``; alpha 1 (ignored). Decoded here, not by Cycles, because
+    Cycles interpolates an sRGB byte image before decoding it. Plain
+    Python (Blender's own Python may have no numpy): each distinct
+    stored value is decoded once."""
+    try:
+        src = bpy.data.images.load(t["file"], check_existing=False)
+    except RuntimeError as e:
+        raise SceneError("%s: Blender cannot read %s: %s" % (key, t["file"], str(e).strip()))
+    try:
+        src.colorspace_settings.name = "Non-Color"
+        src.reload()
+        w, h = src.size
+        px = array.array("f", bytes(4 * w * h * 4))
+        src.pixels.foreach_get(px)
+    finally:
+        bpy.data.images.remove(src)
+    lo, hi = t["range"]
+    srgb = t["encoding"] == "srgb"
+    memo = {}
+
+    def decode(c):
+        if srgb:
+            c = c / 12.92 if c <= 0.04045 else ((c + 0.055) / 1.055) ** 2.4
+        return lo + c * (hi - lo)
+    for i in range(len(px)):
+        if i % 4 == 3:
+            px[i] = 1.0
+            continue
+        c = px[i]
+        v = memo.get(c)
+        if v is None:
+            v = memo[c] = decode(c)
+        px[i] = v
+    img = bpy.data.images.new(PREFIX + "map_" + key, w, h, alpha=False, float_buffer=True, is_data=True)
+    img.colorspace_settings.name = "Non-Color"
+    img.pixels.foreach_set(px)
+    img.use_fake_user = True
+    return img
+
+
+def ply_with_st(path, tmpdir):
+    """A PLY file whose texture coordinates Blender's importer reads: it
+    knows only ``s t``, so a header naming them ``u v`` or ``texture_u
+    texture_v`` is copied into `tmpdir` with those names as ``s t`` (the
+    body, ASCII or binary, unchanged). `path` itself when nothing to do."""
+    with open(path, "rb") as f:
+        head = f.read(65536)
+        end = head.find(b"end_header")
+        if end < 0:
+            return path
+        lines = head[:end].split(b"\n")
+        names = [ln.split()[-1] for ln in lines if ln.startswith(b"property ")]
+        if b"s" in names and b"t" in names:
+            return path
+        for a, b in ((b"u", b"v"), (b"texture_u", b"texture_v")):
+            if a in names and b in names:
+                break
+        else:
+            return path
+        ren = {a: b"s", b: b"t"}
+        out_lines = [ln.rsplit(b" ", 1)[0] + b" " + ren[ln.split()[-1]]
+                     if ln.startswith(b"property ") and ln.split()[-1] in ren else ln for ln in lines]
+        out = os.path.join(tmpdir, "uv.ply")
+        with open(out, "wb") as g:
+            g.write(b"\n".join(out_lines) + head[end:])
+            while True:
+                chunk = f.read(1 << 20)
+                if not chunk:
+                    break
+                g.write(chunk)
+    return out
+
+
+def _math(nt, op, *args):
+    """A Math node of `op` on `args`, each a socket, a node (its first
+    output) or a number (the input's value)."""
+    m = nt.nodes.new("ShaderNodeMath")
+    m.operation = op
+    for i, a in enumerate(args):
+        if isinstance(a, bpy.types.Node):
+            a = a.outputs[0]
+        if isinstance(a, bpy.types.NodeSocket):
+            nt.links.new(a, m.inputs[i])
+        else:
+            m.inputs[i].default_value = a
+    return m
+
+
+def box_uvs(me):
+    """The unit cube template's texture coordinates, per face as a box's
+    in src/scene/texture/uv.rs: a corner (a, b, c) of the cube in
+    Blender's local frame is the fraction (x, y, z) = (a, c, 1 - b) of
+    the box along the scene's axes (Worker._apply_shape: location min,
+    scale size, y and z swapped)."""
+    uv = me.uv_layers.new(name="UVMap")
+    table = {(0, False): lambda x, y, z: (z, y), (0, True): lambda x, y, z: (1 - z, y),
+             (1, False): lambda x, y, z: (x, z), (1, True): lambda x, y, z: (x, 1 - z),
+             (2, False): lambda x, y, z: (1 - x, y), (2, True): lambda x, y, z: (x, y)}
+    for p in me.polygons:
+        nb = p.normal
+        n = (nb.x, nb.z, -nb.y)  # in the scene's axes
+        axis = max(range(3), key=lambda a: abs(n[a]))
+        face = table[(axis, n[axis] > 0)]
+        for li in p.loop_indices:
+            a, b, c = me.vertices[me.loops[li].vertex_index].co
+            uv.data[li].uv = face(a, c, 1.0 - b)
 
 
 # ---------------------------------------------------------------------------
@@ -275,6 +422,7 @@ class Worker:
         self._setup_render_constants()
         self._setup_world()
         self._templates = {}
+        self._map_images = {}  # (file, encoding, range) -> decoded image
 
     # -- one-time setup ---------------------------------------------------
     def _wipe_factory_scene(self):
@@ -399,6 +547,8 @@ class Worker:
         me = bpy.data.meshes.new(PREFIX + "template_" + kind)
         bm.to_mesh(me)
         bm.free()
+        if kind == "box":
+            box_uvs(me)  # unused by an unmapped box
         for p in me.polygons:
             p.use_smooth = smooth
         me.materials.append(None)  # one slot; the material is linked per object
@@ -479,7 +629,7 @@ class Worker:
             self.lights.append((lo, fnode))
 
         # objects
-        for i, (name, stype, mkind, file) in enumerate(obj_structs):
+        for i, (name, stype, mkind, file, maps) in enumerate(obj_structs):
             where = "object '%s'" % name
             own_mesh = None
             if stype in ("sphere", "plane", "box"):
@@ -487,10 +637,16 @@ class Worker:
             elif stype == "quad":
                 me = bpy.data.meshes.new(PREFIX + "quad_" + name)
                 me.from_pydata([(0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0)], [], [(0, 1, 2, 3)])
+                # (s, t) of corner + s edge_u + t edge_v: affine, so exact
+                uv = me.uv_layers.new(name="UVMap")
+                for li, c in zip(range(4), ((0, 0), (1, 0), (1, 1), (0, 1))):
+                    uv.data[li].uv = c
                 me.materials.append(None)
                 own_mesh = me
             elif stype == "mesh":
-                me = import_mesh(file, name, where)
+                me = import_mesh(file, name, where, mapped=bool(maps))
+                if maps and not me.uv_layers:
+                    raise SceneError("%s: Blender read no texture coordinates from %s" % (where, file))
                 own_mesh = me
             else:
                 raise SceneError("%s: shape.type must be sphere, plane, quad or box, got %r" % (where, stype))
@@ -501,10 +657,14 @@ class Worker:
             coll.objects.link(place)
             ob.parent = place
             mat, nodes = self._make_material(PREFIX + "mat_" + name, mkind)
+            if maps:
+                if mkind != "phong":
+                    raise SceneError("%s: texture maps on a transmitting material are not drawn by blender; use phong" % where)
+                self._map_graph(mat.node_tree, nodes, maps, stype)
             ob.material_slots[0].link = "OBJECT"
             ob.material_slots[0].material = mat
             self.objects.append({"obj": ob, "place": place, "shape": stype, "mesh": own_mesh,
-                                 "kind": mkind, "nodes": nodes, "mat": mat})
+                                 "kind": mkind, "nodes": nodes, "mat": mat, "mapped": bool(maps)})
         self.structure = structure
 
     def _make_material(self, name, kind):
@@ -611,6 +771,88 @@ class Worker:
         L.new(add.outputs["Shader"], out.inputs["Surface"])
         nodes.update({"diffuse": diffuse, "at": at, "weight": wp, "fresnel": fr,
                       "lobes": lobes, "mirror": mirror})
+
+
+    # -- texture maps -------------------------------------------------------
+    def map_image(self, t, key):
+        """A map's decoded image, once per worker (kept across rebuilds)."""
+        k = (t["file"], t["encoding"], tuple(t["range"]))
+        if k not in self._map_images:
+            self._map_images[k] = decoded_image(t, key)
+        return self._map_images[k]
+
+    def _uv_socket(self, nt, stype):
+        """scenefit's (u, v) at the shading point, as x and y of a vector:
+        a sphere's longitude and latitude from its object coordinates
+        (Blender's local x, y, z are the scene's x, -z, y, so u =
+        atan2(y, x) / 2 pi, v = 1/2 + asin(z) / pi, per point, no seam),
+        a mapped plane's object x and y (its local axes are e_u and e_v:
+        _apply_shape), the UV map of a quad, a box or a mesh."""
+        N, L = nt.nodes, nt.links
+        tc = N.new("ShaderNodeTexCoord")
+        if stype == "plane":
+            return tc.outputs["Object"]
+        if stype != "sphere":
+            return tc.outputs["UV"]
+        d = N.new("ShaderNodeVectorMath")
+        d.operation = "NORMALIZE"
+        L.new(tc.outputs["Object"], d.inputs[0])
+        xyz = N.new("ShaderNodeSeparateXYZ")
+        L.new(d.outputs["Vector"], xyz.inputs[0])
+        lon = _math(nt, "ARCTAN2", xyz.outputs["Y"], xyz.outputs["X"])
+        lat = _math(nt, "ARCSINE", xyz.outputs["Z"])
+        uv = N.new("ShaderNodeCombineXYZ")
+        L.new(_math(nt, "MULTIPLY", lon, 0.5 / math.pi).outputs[0], uv.inputs[0])
+        L.new(_math(nt, "MULTIPLY_ADD", lat, 1.0 / math.pi, 0.5).outputs[0], uv.inputs[1])
+        return uv.outputs["Vector"]
+
+    def _map_lookup(self, nt, uv, t, key, red):
+        """An Image Texture of the decoded map (Linear = bilinear between
+        texel centres, Repeat) at (u, v) x scale; its colour, or its red."""
+        N, L = nt.nodes, nt.links
+        sc = N.new("ShaderNodeVectorMath")
+        sc.operation = "MULTIPLY"
+        L.new(uv, sc.inputs[0])
+        sc.inputs[1].default_value = (t["scale"][0], t["scale"][1], 1.0)
+        tex = N.new("ShaderNodeTexImage")
+        tex.image = self.map_image(t, key)
+        tex.interpolation = "Linear"
+        tex.extension = "REPEAT"
+        L.new(sc.outputs["Vector"], tex.inputs["Vector"])
+        if not red:
+            return tex.outputs["Color"]
+        # the red channel itself (a colour used as a number is its luminance)
+        sep = N.new("ShaderNodeSeparateRGB")
+        L.new(tex.outputs["Color"], sep.inputs[0])
+        return sep.outputs["R"]
+
+    def _map_graph(self, nt, nodes, sig, stype):
+        """The maps in the phong graph (_phong_graph): diffuse colour =
+        albedo x the colour map; per lobe, ks x the specular map's red and
+        the exponent n = the shininess map's red (the second lobe's too
+        when shininess2 follows), its colour factor ks (n+8)/(n+1) and
+        roughness (2/(n+2))^(1/4) computed per shading point as
+        _apply_phong computes them from the scalars."""
+        maps, n2_own = {k: {"file": f, "encoding": e, "scale": s, "range": r}
+                        for k, f, e, s, r in sig[0]}, sig[1]
+        uv = self._uv_socket(nt, stype)
+        if "color_map" in maps:
+            mul = nt.nodes.new("ShaderNodeVectorMath")
+            mul.operation = "MULTIPLY"
+            nt.links.new(self._map_lookup(nt, uv, maps["color_map"], "color_map", False), mul.inputs[1])
+            nt.links.new(mul.outputs["Vector"], nodes["diffuse"].inputs["Color"])
+            nodes["albedo_mul"] = mul
+        spec = self._map_lookup(nt, uv, maps["specular_map"], "specular_map", True) if "specular_map" in maps else 1.0
+        shin = self._map_lookup(nt, uv, maps["shininess_map"], "shininess_map", True) if "shininess_map" in maps else None
+        nodes["mapped_lobes"] = []
+        for j, (k, g) in enumerate(nodes["lobes"]):
+            ks = _math(nt, "MULTIPLY", 0.0, spec)
+            n = _math(nt, "ADD", shin if shin is not None and (j == 0 or not n2_own) else 0.0, 0.0)
+            f = _math(nt, "DIVIDE", _math(nt, "ADD", n, 8.0), _math(nt, "ADD", n, 1.0))
+            nt.links.new(_math(nt, "MULTIPLY", ks, f).outputs[0], k.inputs[1])
+            r = _math(nt, "POWER", _math(nt, "DIVIDE", 2.0, _math(nt, "ADD", n, 2.0)), 0.25)
+            nt.links.new(r.outputs[0], g.inputs["Roughness"])
+            nodes["mapped_lobes"].append((ks, n))
 
     # -- values -------------------------------------------------------------
     def apply(self, desc):
@@ -738,7 +980,14 @@ class Worker:
             _set(ob, "scale", (rad, rad, rad))
         elif st == "plane":
             _set(ob, "location", B(sh["point"]))
-            _set(ob, "rotation_quaternion", _rot_z_to(B(sh["normal"]), where))
+            if ent["mapped"]:
+                # local x, y = the texture axes e_u, e_v: object coordinates are (u, v)
+                eu, ev = plane_axes(sh["normal"])
+                n = normalize(sh["normal"], where + ".normal")
+                rot = Matrix((B(eu), B(ev), B(n))).transposed().to_quaternion()
+                _set(ob, "rotation_quaternion", rot)
+            else:
+                _set(ob, "rotation_quaternion", _rot_z_to(B(sh["normal"]), where))
         elif st == "box":
             lo_, hi = sh["min"], sh["max"]
             _set(ob, "location", (lo_[0], -hi[2], lo_[1]))
@@ -780,6 +1029,13 @@ class Worker:
     def _apply_phong(self, nodes, m, base, lights):
         f0 = m["f0"]
         _set(nodes["diffuse"].inputs["Color"], "default_value", base)
+        if "albedo_mul" in nodes:
+            _set(nodes["albedo_mul"].inputs[0], "default_value", base[:3])
+        for (ks_node, n_node), (ks_, n_) in zip(nodes.get("mapped_lobes", ()),
+                                                ((m["ks"], m["n"]), (m["ks2"], m["n2"]))):
+            _set(ks_node.inputs[0], "default_value", max(ks_, 0.0))
+            if not n_node.inputs[0].is_linked:
+                _set(n_node.inputs[0], "default_value", n_)
         _set(nodes["fresnel"].inputs[1], "default_value", (1.0 - f0) / f0)
         for (k, g), (ks_, n_) in zip(nodes["lobes"], ((m["ks"], m["n"]), (m["ks2"], m["n2"]))):
             _set(k.inputs[1], "default_value", max(ks_, 0.0) * (n_ + 8.0) / (n_ + 1.0))

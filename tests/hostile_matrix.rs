@@ -32,6 +32,8 @@ enum Kind {
     /// A calibration tool's text file (COLMAP's cameras.txt and
     /// images.txt, an OpenCV YAML).
     Text,
+    /// A .blend file (`scenefit import`; Blender reads it).
+    Blend,
 }
 
 /// One file a command reads: the command line (run in a copy of the
@@ -288,6 +290,20 @@ const INPUTS: &[Input] = &[
         kind: Kind::Text,
         output: "cams.json",
     },
+    Input {
+        label: "import (Blender)",
+        args: &["import", "u.blend", "-o", "imp.json"],
+        file: "u.blend",
+        kind: Kind::Blend,
+        output: "imp.json",
+    },
+    Input {
+        label: "export --to blender",
+        args: &["export", "s.json", "--to", "blender", "-o", "out.blend"],
+        file: "s.json",
+        kind: Kind::Json,
+        output: "out.blend",
+    },
 ];
 
 /// `import-cameras` from the fixture's COLMAP model, checked against its
@@ -377,7 +393,7 @@ fn mkfifo(p: &Path) {
 fn wrong_format(kind: Kind) -> Vec<u8> {
     match kind {
         Kind::Json | Kind::Text => png_header(4, 4),
-        Kind::Image | Kind::Exr | Kind::Font | Kind::Mesh => {
+        Kind::Image | Kind::Exr | Kind::Font | Kind::Mesh | Kind::Blend => {
             br#"{"not": "this kind of file"}"#.to_vec()
         }
     }
@@ -397,6 +413,8 @@ fn huge_declared(kind: Kind, valid: &[u8]) -> Vec<u8> {
             .copied()
             .collect(),
         Kind::Text => huge_declared_text(valid),
+        // Blender's signature, then a file block declaring 2 GiB
+        Kind::Blend => [&b"BLENDER-v304REND"[..], &[0xff, 0xff, 0xff, 0x7f], &[0u8; 40]].concat(),
         Kind::Json => {
             let mut v: Value = serde_json::from_slice(valid).unwrap();
             if set_sizes(&mut v) {
@@ -505,6 +523,11 @@ fn fixture() -> tempfile::TempDir {
     );
     let yml = "%YAML:1.0\n---\nimage_width: 16\nimage_height: 12\ncamera_matrix: !!opencv-matrix\n   rows: 3\n   cols: 3\n   dt: d\n   data: [ 20., 0., 7.5, 0., 20., 5.5, 0., 0., 1. ]\ndistortion_coefficients: !!opencv-matrix\n   rows: 1\n   cols: 5\n   dt: d\n   data: [ 0., 0., 0., 0., 0. ]\nrvec: !!opencv-matrix\n   rows: 3\n   cols: 1\n   dt: d\n   data: [ 3.3, 0., 0. ]\ntvec: !!opencv-matrix\n   rows: 3\n   cols: 1\n   dt: d\n   data: [ 0., 0.5, 5.3 ]\n";
     write(&p.join("p1.yml"), yml.as_bytes());
+    // a .blend's signature and a block: only its stand-ins are read
+    write(
+        &p.join("u.blend"),
+        &[&b"BLENDER-v304GLOB"[..], &[0u8; 64]].concat(),
+    );
     let font = Path::new("/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf");
     let font = std::fs::read(font).unwrap_or_else(|_| huge_declared(Kind::Font, b""));
     write(&p.join("f.ttf"), &font);

@@ -313,6 +313,51 @@ fn a_larger_budget_continues_a_finished_run() {
 }
 
 #[test]
+fn a_checkpoint_saved_by_an_earlier_build_resumes_as_todays() {
+    // One photograph's checkpoint as builds before the one fit path saved
+    // it (format 2) continues to the result today's checkpoint gives.
+    let d = setup();
+    assert!(fit(d.path(), "run", &[]).status.success());
+    let c = json(&d.path().join("run/checkpoint.json"));
+    let old = serde_json::json!({
+        "format": "scenefit-checkpoint/2",
+        "identity": c["identities"][0],
+        "phase_index": c["blocks_done"],
+        "base": c["base"],
+        "search": c["within"]["search"],
+        "generation_offset": c["generations"],
+        "evaluations_before": c["evaluations"],
+        "elapsed_before": c["seconds"],
+    });
+    copy_dir(&d.path().join("run"), &d.path().join("old"));
+    std::fs::write(d.path().join("old/checkpoint.json"), old.to_string()).unwrap();
+    for run in ["run", "old"] {
+        let out = fit(d.path(), run, &["--resume", "--generations", "12"]);
+        assert!(out.status.success(), "{run}: {}", stderr(&out));
+    }
+    let (now, was) = (
+        json(&d.path().join("run/result.json")),
+        json(&d.path().join("old/result.json")),
+    );
+    assert_eq!(was["generations"], 12);
+    assert_eq!(now["params"], was["params"]);
+    assert_eq!(now["evaluations"], was["evaluations"]);
+    // Saved again in today's format.
+    let again = json(&d.path().join("old/checkpoint.json"));
+    assert_eq!(again["format"], "scenefit-checkpoint/3");
+}
+
+/// Copies the files of run directory `from` into a new directory `to`.
+fn copy_dir(from: &Path, to: &Path) {
+    std::fs::create_dir_all(to).unwrap();
+    for e in std::fs::read_dir(from).unwrap().flatten() {
+        if e.path().is_file() && e.file_name() != ".scenefit.lock" {
+            std::fs::copy(e.path(), to.join(e.file_name())).unwrap();
+        }
+    }
+}
+
+#[test]
 fn a_resumed_finished_run_is_the_same_result() {
     let d = setup();
     assert!(fit(d.path(), "run", &[]).status.success());
@@ -344,11 +389,11 @@ fn a_checkpoint_of_another_phase_layout_is_refused() {
     assert!(fit(d.path(), "run", &[]).status.success());
     let p = d.path().join("run/checkpoint.json");
     let mut c = json(&p);
-    c["phase_index"] = serde_json::json!(7);
+    c["blocks_done"] = serde_json::json!(7);
     std::fs::write(&p, c.to_string()).unwrap();
     refused(
         &fit(d.path(), "run", &["--resume"]),
-        &["checkpoint.json", "phase_index"],
+        &["checkpoint.json", "blocks_done"],
     );
 }
 
@@ -525,7 +570,7 @@ fn a_finished_fit_keeps_its_population_for_the_report() {
     let d = setup();
     assert!(fit(d.path(), "run", &[]).status.success());
     let c = json(&d.path().join("run/checkpoint.json"));
-    let pop = &c["search"]["de"]["population"];
+    let pop = &c["within"]["search"]["de"]["population"];
     assert_eq!(pop.as_array().map(|p| p.len()), Some(10), "{c}");
 }
 

@@ -211,7 +211,7 @@ fn handover_narrows_bounds_around_stage1_and_seeds_stage2() {
     assert!(run.join("report.html").is_file());
     // The finished stage keeps its final population in its checkpoint.
     let c = json(&run.join("stage2/checkpoint.json"));
-    assert!(c["search"]["de"]["population"]
+    assert!(c["within"]["search"]["de"]["population"]
         .as_array()
         .is_some_and(|p| !p.is_empty()));
     assert!(run.join("stage1/trace.tsv").is_file());

@@ -5,7 +5,7 @@
 //! memory check counts.
 
 use crate::error::Result;
-use crate::fit::set::shots::{Entry, Shot};
+use crate::fit::set::shots::Shot;
 use crate::fit::set::{SetConfig, SetOutcome};
 use crate::fit::FitTarget;
 use crate::fit::{FitConfig, FitOutcome, FitResult, Observer};
@@ -27,21 +27,8 @@ pub struct Photographs {
 impl Photographs {
     /// One photograph of `scene`, given on its own.
     pub fn one(scene: &Scene, target: FitTarget) -> Photographs {
-        let entry = Entry {
-            name: "target".into(),
-            target: target.path.clone().unwrap_or_default(),
-            mask: None,
-            encoding: None,
-            set: Default::default(),
-        };
-        let shot = Shot {
-            name: entry.name.clone(),
-            scene: scene.clone(),
-            target,
-            entry,
-        };
         Photographs {
-            shots: vec![shot],
+            shots: vec![Shot::one(scene, target)],
             file: None,
         }
     }
@@ -127,22 +114,27 @@ pub fn fit(
         .inputs
         .push(("the scene".into(), request.scene_file.to_path_buf()));
     let (renderer, scene) = (request.renderer, request.scene);
-    match (&photos.file, photos.shots.as_slice()) {
-        (None, [one]) => crate::fit::run(scene, &one.target, renderer, &config, dir, observer)
-            .map(|o| Fitted::One(Box::new(o))),
-        (file, shots) => {
-            config
-                .inputs
-                .extend(file.iter().map(|f| ("--shots".into(), f.clone())));
-            let set = SetConfig {
-                spread: Vec::new(),
-                fit: config,
-                rounds: request.rounds,
-                warm: false,
-                joint: request.joint,
-            };
-            crate::fit::set::run(scene, shots, renderer, &set, dir, observer)
-                .map(|o| Fitted::Set(Box::new(o)))
-        }
+    // One photograph given on its own keeps one photograph's run
+    // directory and is fitted phase after phase; a shots file's are
+    // fitted by blocks. Both through the one fit path.
+    let alone = photos.file.is_none() && photos.shots.len() == 1;
+    config
+        .inputs
+        .extend(photos.file.iter().map(|f| ("--shots".into(), f.clone())));
+    let run_dir = crate::fit::set::driver::open(dir, &photos.shots, alone, &config)?;
+    let set = SetConfig {
+        spread: Vec::new(),
+        fit: config,
+        rounds: request.rounds,
+        warm: false,
+        joint: request.joint,
+    };
+    let (dir, shots) = (Some(&run_dir), photos.shots.as_slice());
+    if alone {
+        crate::fit::set::phase::run_one(scene, &shots[0].target, renderer, &set.fit, dir, observer)
+            .map(|o| Fitted::One(Box::new(o)))
+    } else {
+        crate::fit::set::run_in(scene, shots, renderer, &set, dir, observer)
+            .map(|o| Fitted::Set(Box::new(o)))
     }
 }

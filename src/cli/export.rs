@@ -26,6 +26,13 @@ pub struct ExportArgs {
 
 pub fn run(a: ExportArgs) -> Result<()> {
     let exporter = formats::exporter_for(&a.to)?;
+    if exporter.name == formats::BLENDER {
+        // Blender's export writes one new .blend file named by -o, not a
+        // directory (docs/interchange.md "Blender").
+        crate::interchange::blend_export::export(&a.scene, &a.output)?;
+        println!("{} written", a.output.display());
+        return Ok(());
+    }
     let scene = crate::scene::load(&a.scene)?;
     let python = python(a.python.clone())?;
     let mut inputs: Vec<PathBuf> = vec![a.scene.clone()];

@@ -27,6 +27,16 @@ pub struct ImportArgs {
 
 pub fn run(a: ImportArgs) -> Result<()> {
     let importer = formats::importer_for(&a.file)?;
+    if importer.name == formats::BLENDER {
+        // Blender's import keeps its own output rules for now (meshes
+        // beside the scene; docs/interchange.md "Blender").
+        let warnings = crate::interchange::blend_import::import(&a.file, &a.output, &a.free)?;
+        for w in &warnings {
+            eprintln!("warning: {w}");
+        }
+        println!("{} written", a.output.display());
+        return Ok(());
+    }
     let python = super::export::python(a.python.clone())?;
     let assets = scene_files::import_paths(&a.file, &a.output)?;
     let job = scene_files::ImportJob {

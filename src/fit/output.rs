@@ -1,11 +1,13 @@
-//! result.json and what a finished fit leaves in memory and on disk:
-//! result.json, fitted_scene.json and best.png, result.json last so that
-//! its presence means the run finished.
+//! result.json and what a finished fit leaves in memory and on disk, one
+//! writer for one photograph and a set: each best image (best.png, or
+//! best_NAME.png for each photograph of a set), a set's shots.json,
+//! fitted_scene.json and result.json, result.json last so that its
+//! presence means the run finished.
 
 use crate::error::{Error, Result};
 use crate::metric::Deviation;
 use crate::raster::Image;
-use crate::rundir::{RunDir, BEST, FITTED_SCENE, RESULT};
+use crate::rundir::{RunDir, BEST, FITTED_SCENE, RESULT, SHOTS};
 use crate::scene::field::{Field, LightField, Value};
 use crate::scene::{ParamSpace, Scene};
 use serde::{Deserialize, Serialize};
@@ -190,9 +192,38 @@ pub struct FitOutcome {
     pub population: Option<Population>,
 }
 
-/// Writes the final files; result.json last.
-pub fn finish(dir: &RunDir, outcome: &FitOutcome) -> Result<()> {
-    dir.write_image(BEST, &outcome.image)?;
-    dir.write_json(FITTED_SCENE, &outcome.scene)?;
-    dir.write_json(RESULT, &outcome.result)
+/// What a finished fit writes, whatever its photographs.
+pub struct Written<'a, S: Serialize> {
+    /// Each best image and its file name.
+    pub images: Vec<(String, &'a Image)>,
+    /// A set's photographs, with absolute paths (shots.json), for
+    /// `diagnose`.
+    pub shots: Option<&'a S>,
+    pub scene: &'a Scene,
+    pub result: &'a FitResult,
+}
+
+/// Writes a finished fit's files; result.json last.
+pub fn write<S: Serialize>(dir: &RunDir, w: &Written<S>) -> Result<()> {
+    for (name, image) in &w.images {
+        dir.write_image(name, image)?;
+    }
+    if let Some(shots) = w.shots {
+        dir.write_json(SHOTS, shots)?;
+    }
+    dir.write_json(FITTED_SCENE, w.scene)?;
+    dir.write_json(RESULT, w.result)
+}
+
+/// One photograph's files: best.png, fitted_scene.json, result.json.
+pub fn write_one(dir: &RunDir, outcome: &FitOutcome) -> Result<()> {
+    write(
+        dir,
+        &Written::<()> {
+            images: vec![(BEST.to_string(), &outcome.image)],
+            shots: None,
+            scene: &outcome.scene,
+            result: &outcome.result,
+        },
+    )
 }

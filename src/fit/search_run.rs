@@ -9,7 +9,7 @@ use super::observers::{Failures, Progress};
 use super::problem::ShotsProblem;
 use super::{FitConfig, Observer};
 use crate::error::{Error, Result};
-use crate::optimize::{Searcher, StopReason, StopRule};
+use crate::optimize::{Search, Searcher, StopReason, StopRule};
 use crate::rundir::RunDir;
 
 /// The observers that write into the run directory (none in memory).
@@ -51,7 +51,8 @@ pub struct SearchRun<'a> {
 }
 
 impl SearchRun<'_> {
-    /// Runs `search` on `problem` to the stop rule; `save` is called after
+    /// Runs `search` (a new one, or a resumed one whose best point is
+    /// rendered first) on `problem` to the stop rule; `save` is called after
     /// every generation, before any observer sees it (`Executor::run`).
     pub fn run(
         &self,
@@ -61,6 +62,12 @@ impl SearchRun<'_> {
         observer: &mut dyn Observer,
         save: &mut dyn FnMut(&Searcher, f64) -> Result<()>,
     ) -> Result<StopReason> {
+        // A resumed search's best images, which the problem reports and
+        // the outcome keeps, are those of its best point.
+        if search.evaluations() > 0 {
+            let (best, f) = search.best();
+            problem.adopt_best(best, f);
+        }
         let mut observers: Vec<&mut dyn Observer> = Vec::new();
         if let Some(f) = logs.failures.as_mut() {
             observers.push(f);

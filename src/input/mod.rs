@@ -134,6 +134,17 @@ pub fn read_tail(path: &Path, n: u64) -> std::result::Result<Vec<u8>, CappedRead
     Ok(bytes)
 }
 
+/// Reads the first `n` bytes (at most) of the regular file `path`, and
+/// gives its size: a file's signature, before another program reads it.
+pub fn read_head(path: &Path, n: u64) -> std::result::Result<(Vec<u8>, u64), CappedRead> {
+    let (file, len) = open_regular(path)?;
+    let mut bytes = Vec::with_capacity(n.min(len) as usize);
+    file.take(n)
+        .read_to_end(&mut bytes)
+        .map_err(CappedRead::Io)?;
+    Ok((bytes, len))
+}
+
 /// Reads a text file the tool wrote, of at most `limit` bytes.
 pub fn read_text_capped(path: &Path, limit: u64) -> Result<String> {
     let bytes =

@@ -5,6 +5,9 @@
 //! into [`camera::Calibrated`], the one pinhole in OpenCV's conventions the
 //! scene format holds; `shots_out` matches them to photographs.
 
+pub mod blend_export;
+pub mod blend_import;
+mod blend_run;
 pub mod camera;
 pub mod colmap;
 pub mod formats;

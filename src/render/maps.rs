@@ -11,20 +11,60 @@ use crate::scene::Scene;
 pub const PHONG: &[MapKind] = &[MapKind::Color, MapKind::Specular, MapKind::Shininess];
 
 /// The maps POV-Ray, Blender and Mitsuba draw.
-pub const POVRAY: &[MapKind] = &[];
-pub const BLENDER: &[MapKind] = &[];
+pub const POVRAY: &[MapKind] = &[MapKind::Color, MapKind::Specular];
+pub const BLENDER: &[MapKind] = &[MapKind::Color, MapKind::Specular, MapKind::Shininess];
 pub const MITSUBA: &[MapKind] = &[MapKind::Color, MapKind::Specular, MapKind::Shininess];
 
-/// What Mitsuba draws maps on: not a box (its `cube` mesh has texture
-/// coordinates of its own) nor glass (the `principled` BSDF).
-pub fn mitsuba_limits(scene: &Scene) -> Vec<Refusal> {
+/// Every map refusal of the Blender worker (`mitsuba` false) or the
+/// Mitsuba worker: the maps it does not draw, and what it does not draw
+/// them on (`limits`).
+pub fn worker_refusals(scene: &Scene, mitsuba: bool) -> Vec<Refusal> {
+    let (name, drawn) = if mitsuba {
+        ("mitsuba", MITSUBA)
+    } else {
+        ("blender", BLENDER)
+    };
+    let mut out = refusals(scene, name, drawn);
+    out.extend(limits(scene, mitsuba));
+    out
+}
+
+/// Every map refusal of POV-Ray: the maps it does not draw (the
+/// shininess map: its `roughness` is one number per texture, and a blend
+/// of two textures' highlights is not the lobe of the blended exponent),
+/// and what it does not draw them on: a box (no per-face coordinates),
+/// glass, and a specular map beside `specular2` (the specular map is a
+/// patterned texture, and POV-Ray layers nothing over one).
+pub fn povray_refusals(scene: &Scene) -> Vec<Refusal> {
+    let mut out = refusals(scene, "povray", POVRAY);
+    out.extend(limits(scene, true).into_iter().map(|mut r| {
+        r.why = r.why.replace("mitsuba", "mitsuba or povray");
+        r
+    }));
+    for o in &scene.objects {
+        let m = &o.material;
+        if m.specular_map.is_some() && m.specular2.is_some_and(|k| k > 0.0) {
+            out.push(Refusal::new(
+                format!("objects.{}.material.specular2", o.name),
+                "a second lobe beside a specular_map is not drawn by povray (it layers no texture over a patterned one); use phong, blender or mitsuba",
+            ));
+        }
+    }
+    out
+}
+
+/// What a worker draws maps on: not glass (Blender's and Mitsuba's
+/// principled BSDF, which takes no maps here), and for Mitsuba
+/// (`refuse_box`) not a box (its `cube` mesh has texture coordinates of
+/// its own; Blender's box template carries scenefit's per face).
+fn limits(scene: &Scene, refuse_box: bool) -> Vec<Refusal> {
     let mut out = Vec::new();
     for o in scene.objects.iter().filter(|o| o.material.has_maps()) {
         let at = format!("objects.{}", o.name);
-        if matches!(o.shape, crate::scene::Shape::Box { .. }) {
+        if refuse_box && matches!(o.shape, crate::scene::Shape::Box { .. }) {
             out.push(Refusal::new(
                 format!("{at}.shape"),
-                "texture maps on a box are drawn by phong only; use phong, or six quads",
+                "texture maps on a box are not drawn by mitsuba; use phong or blender, or six quads",
             ));
         }
         if o.material.transmission > 0.0 {

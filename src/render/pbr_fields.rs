@@ -46,15 +46,7 @@ pub fn distortion(scene: &Scene, backend: &str) -> Option<Refusal> {
 fn refusals(scene: &Scene, mitsuba: bool) -> Vec<Refusal> {
     let name = if mitsuba { "mitsuba" } else { "blender" };
     let mut out: Vec<Refusal> = distortion(scene, name).into_iter().collect();
-    let drawn = if mitsuba {
-        super::maps::MITSUBA
-    } else {
-        super::maps::BLENDER
-    };
-    out.extend(super::maps::refusals(scene, name, drawn));
-    if mitsuba {
-        out.extend(super::maps::mitsuba_limits(scene));
-    }
+    out.extend(super::maps::worker_refusals(scene, mitsuba));
     let c = &scene.camera;
     if mitsuba && c.kind == CameraKind::Pinhole && c.fx != c.fy {
         out.push(Refusal::new(

@@ -43,13 +43,25 @@
 //!   ks2 (n2+8)/(8 pi)`, `roughness 1/n2`: POV-Ray adds a layer's highlight
 //!   whatever its transparency (measured: the same image as the lobe in the
 //!   bottom finish).
+//! - texture maps (`color_map`, `specular_map`; `mapped_material`): the
+//!   files `pov_maps` wrote into the run directory (the SDL names only
+//!   them) as bilinear `image_pattern`s placed by `mapping`; the colour
+//!   map as a pigment averaging three channel patterns, the specular map
+//!   as a patterned texture blending the texture without and with its
+//!   highlight. Refused (`maps::povray_refusals`): the shininess map, a
+//!   map on a box or on glass, a specular map beside `specular2`.
 
 use super::backend::Refusal;
+use super::pov_maps::Channels;
 use crate::math::V3;
 use crate::scene::pinhole::Pinhole;
-use crate::scene::{CameraKind, Falloff, LightKind, Material, Scene, Shape, Transform, Vec3};
+use crate::scene::texture::MapKind;
+use crate::scene::{
+    CameraKind, Falloff, LightKind, Material, Object, Scene, Shape, TextureRef, Transform, Vec3,
+};
 use std::f64::consts::PI;
 use std::fmt::Write;
+use std::sync::Arc;
 
 /// `fade_distance` of inverse-square lights, metres. POV-Ray's fade is
 /// 2 / (1 + (d/D)^2); with the colour scaled by 1/(2 D^2) that is
@@ -116,7 +128,7 @@ pub fn refusals(scene: &Scene) -> Vec<Refusal> {
     if let Some(r) = super::pbr_fields::distortion(scene, "povray") {
         out.push(r);
     }
-    out.extend(super::maps::refusals(scene, "povray", super::maps::POVRAY));
+    out.extend(super::maps::povray_refusals(scene));
     for o in &scene.objects {
         let m = &o.material;
         if m.albedo_map.is_some() {
@@ -162,8 +174,19 @@ fn fade(p: f64) -> (f64, String) {
     )
 }
 
-/// The scene file POV-Ray renders.
+/// Where the SDL finds a map's files (`pov_maps::PovMaps::get`).
+pub type MapSource<'a> = &'a dyn Fn(&TextureRef, MapKind) -> Result<Arc<Channels>, String>;
+
+/// The scene file POV-Ray renders, for a scene without texture maps (a
+/// map needs files in a run directory: `sdl_with`).
 pub fn sdl(scene: &Scene) -> Result<String, String> {
+    sdl_with(scene, &|_, k| {
+        Err(format!("{}: no run directory to write it into", k.key()))
+    })
+}
+
+/// The scene file POV-Ray renders, its maps' files from `maps`.
+pub fn sdl_with(scene: &Scene, maps: MapSource) -> Result<String, String> {
     // a variant may move a free field where POV-Ray cannot follow
     if let Some(r) = refusals(scene).first() {
         return Err(format!("{}: {}", r.field, r.why));
@@ -196,57 +219,69 @@ pub fn sdl(scene: &Scene) -> Result<String, String> {
         light(&mut s, i, l)?;
     }
     for (i, o) in scene.objects.iter().enumerate() {
-        let shape = match o.shape {
-            Shape::Sphere { center, radius } => {
-                format!("sphere {{ {}, {}", vec(pov(center)), num(radius))
-            }
-            Shape::Plane { point, normal } => {
-                let n = normalized(pov(normal)).ok_or_else(|| {
-                    format!(
-                        "objects.{}.shape.normal: expected a non-zero vector",
-                        o.name
-                    )
-                })?;
-                format!("plane {{ {}, {}", vec(n), num(dot(n, pov(point))))
-            }
-            Shape::Quad {
-                corner,
-                edge_u,
-                edge_v,
-            } => {
-                let (c, u, v) = (pov(corner), pov(edge_u), pov(edge_v));
-                let p = [c, add(c, u), add(add(c, u), v), add(c, v), c];
-                format!(
-                    "polygon {{ 5, {}",
-                    p.iter().map(|x| vec(*x)).collect::<Vec<_>>().join(", ")
-                )
-            }
-            Shape::Box { min: lo, max: hi } => format!(
-                "box {{ {}, {}",
-                vec([lo[0], lo[1], -hi[2]]),
-                vec([hi[0], hi[1], -lo[2]])
-            ),
-            Shape::Mesh { ref file } => {
-                let m = crate::scene::mesh::get(std::path::Path::new(file))
-                    .map_err(|e| format!("objects.{}.shape.file: {e}", o.name))?;
-                mesh2(&m)
-            }
-        };
-        // names are never written: the SDL holds only numbers and keywords
-        let _ = writeln!(
-            s,
-            "// objects[{i}]\n{shape}\n  {}{}\n}}",
-            material(&o.material),
-            o.transform.as_ref().map_or(String::new(), placement)
-        );
+        object(&mut s, i, o, maps)?;
     }
     Ok(s)
 }
 
+/// One object: its shape, its texture and its placement.
+fn object(s: &mut String, i: usize, o: &Object, maps: MapSource) -> Result<(), String> {
+    let mapped = o.material.has_maps();
+    let shape = match o.shape {
+        Shape::Sphere { center, radius } => {
+            format!("sphere {{ {}, {}", vec(pov(center)), num(radius))
+        }
+        Shape::Plane { point, normal } => {
+            let n = normalized(pov(normal)).ok_or_else(|| {
+                format!(
+                    "objects.{}.shape.normal: expected a non-zero vector",
+                    o.name
+                )
+            })?;
+            format!("plane {{ {}, {}", vec(n), num(dot(n, pov(point))))
+        }
+        Shape::Quad {
+            corner,
+            edge_u,
+            edge_v,
+        } => {
+            let (c, u, v) = (pov(corner), pov(edge_u), pov(edge_v));
+            let p = [c, add(c, u), add(add(c, u), v), add(c, v), c];
+            format!(
+                "polygon {{ 5, {}",
+                p.iter().map(|x| vec(*x)).collect::<Vec<_>>().join(", ")
+            )
+        }
+        Shape::Box { min: lo, max: hi } => format!(
+            "box {{ {}, {}",
+            vec([lo[0], lo[1], -hi[2]]),
+            vec([hi[0], hi[1], -lo[2]])
+        ),
+        Shape::Mesh { ref file } => {
+            let m = crate::scene::mesh::get(std::path::Path::new(file))
+                .map_err(|e| format!("objects.{}.shape.file: {e}", o.name))?;
+            mesh2(&m, mapped)
+        }
+    };
+    let texture = if mapped {
+        mapped_material(o, maps)?
+    } else {
+        material(&o.material)
+    };
+    // names are never written: the SDL holds only numbers and keywords
+    let _ = writeln!(
+        s,
+        "// objects[{i}]\n{shape}\n  {texture}{}\n}}",
+        o.transform.as_ref().map_or(String::new(), placement)
+    );
+    Ok(())
+}
+
 /// A mesh as `mesh2` (its numbers only, z mirrored like every point):
 /// smooth triangles when the file gives vertex normals (POV-Ray then takes
-/// the face indices for the normals too), flat ones otherwise.
-fn mesh2(m: &crate::scene::mesh::Mesh) -> String {
+/// the face indices for the normals too), flat ones otherwise; `uv`: the
+/// file's texture coordinates as `uv_vectors` (indexed as the vertices).
+fn mesh2(m: &crate::scene::mesh::Mesh, uv: bool) -> String {
     let mut s = String::with_capacity(64 * (m.positions.len() + m.triangles.len()));
     let list = |s: &mut String, name: &str, items: &mut dyn Iterator<Item = String>, n: usize| {
         let _ = write!(s, "\n  {name} {{ {n}");
@@ -269,6 +304,17 @@ fn mesh2(m: &crate::scene::mesh::Mesh) -> String {
             "normal_vectors",
             &mut m.normals.iter().map(|p| vec(pov(*p))),
             n,
+        );
+    }
+    if uv && !m.texcoords.is_empty() {
+        list(
+            &mut s,
+            "uv_vectors",
+            &mut m
+                .texcoords
+                .iter()
+                .map(|t| format!("<{}, {}>", num(t[0]), num(t[1]))),
+            m.texcoords.len(),
         );
     }
     let faces = &mut m
@@ -401,7 +447,6 @@ fn light(s: &mut String, i: usize, l: &crate::scene::Light) -> Result<(), String
 /// The texture (and interior) of a material, see the module doc.
 fn material(m: &Material) -> String {
     let t = m.transmission.min(MAX_TRANSMIT);
-    let opacity = 1.0 - t;
     let c = m.color;
     let pigment = if t > 0.0 {
         format!(
@@ -414,13 +459,26 @@ fn material(m: &Material) -> String {
     } else {
         rgb(c, 1.0)
     };
+    let finish = finish(m, 1.0 - t, 1.0);
+    let interior = if t > 0.0 {
+        format!(" interior {{ ior {} }}", num(m.ior))
+    } else {
+        String::new()
+    };
+    let layer = second_lobe(m, t);
+    format!("texture {{ pigment {{ {pigment} }} finish {{ {finish} }} }}{layer}{interior}")
+}
+
+/// A material's finish: ambient and diffuse (undoing POV-Ray's scaling by
+/// `opacity`), the first lobe with ks x `ks_scale`, the mirror.
+fn finish(m: &Material, opacity: f64, ks_scale: f64) -> String {
     let mut finish = format!(
         "ambient {} diffuse {}",
         num(m.diffuse / opacity),
         num(m.diffuse / (PI * opacity))
     );
-    if m.specular > 0.0 {
-        let ks = m.specular * (m.shininess + 8.0) / (8.0 * PI);
+    if m.specular * ks_scale > 0.0 {
+        let ks = m.specular * (m.shininess + 8.0) / (8.0 * PI) * ks_scale;
         let _ = write!(
             finish,
             " specular {} roughness {}",
@@ -431,11 +489,11 @@ fn material(m: &Material) -> String {
     if m.reflection > 0.0 {
         let _ = write!(finish, " reflection {{ {} }}", num(m.reflection));
     }
-    let interior = if t > 0.0 {
-        format!(" interior {{ ior {} }}", num(m.ior))
-    } else {
-        String::new()
-    };
+    finish
+}
+
+/// The second lobe as a transparent layer on top (none on glass).
+fn second_lobe(m: &Material, t: f64) -> String {
     let mut layer = String::new();
     if let Some(ks2) = m.specular2.filter(|&k| k > 0.0 && t == 0.0) {
         let n2 = m.shininess2.unwrap_or(m.shininess);
@@ -446,7 +504,118 @@ fn material(m: &Material) -> String {
             num(1.0 / n2.max(1e-9))
         );
     }
-    format!("texture {{ pigment {{ {pigment} }} finish {{ {finish} }} }}{layer}{interior}")
+    layer
+}
+
+/// The texture of a material with maps (opaque; see the module doc): the
+/// pigment c x the colour map as the average of three channel patterns,
+/// channel k `color_map`ped from 0 to 3 c_k s (s the factor the files
+/// were divided by: `pov_maps`); a specular map as a patterned texture
+/// blending that texture without and with its highlight, which is linear
+/// in ks, so the blend is ks x the map.
+fn mapped_material(o: &Object, maps: MapSource) -> Result<String, String> {
+    let m = &o.material;
+    let get = |k: MapKind, t: &TextureRef| -> Result<(Arc<Channels>, String, String), String> {
+        let ch = maps(t, k).map_err(|e| format!("objects.{}.material.{e}", o.name))?;
+        let (pre, post) = mapping(&o.shape, t.scale()).ok_or_else(|| {
+            format!(
+                "objects.{}.material.{}: not drawn on this shape by POV-Ray",
+                o.name,
+                k.key()
+            )
+        })?;
+        Ok((ch, pre, post))
+    };
+    let pigment = match &m.color_map {
+        Some(t) => {
+            let (ch, pre, mut post) = get(MapKind::Color, t)?;
+            // inside a specular map's patterned texture a planar pattern
+            // is carried by that texture's transform too (measured): only
+            // the ratio of the two scales is left to apply
+            let planar = pre.is_empty();
+            if let (true, Some(s)) = (planar, &m.specular_map) {
+                let (a, b) = (s.scale(), t.scale());
+                post = format!(" scale <{}, {}, 1>", num(a[0] / b[0]), num(a[1] / b[1]));
+            }
+            let entries: String = (0..3)
+                .map(|k| {
+                    let mut c = [0.0; 3];
+                    c[k] = 3.0 * m.color[k] * ch.scale;
+                    format!(
+                        " [1 {pre}{} color_map {{ [0 rgb 0] [1 {}] }}{post}]",
+                        pattern(&ch.files[k]),
+                        rgb(c, 1.0)
+                    )
+                })
+                .collect();
+            format!("average pigment_map {{{entries} }}")
+        }
+        None => rgb(m.color, 1.0),
+    };
+    let base = |ks: f64| {
+        format!(
+            "pigment {{ {pigment} }} finish {{ {} }}",
+            finish(m, 1.0, ks)
+        )
+    };
+    Ok(match &m.specular_map {
+        None => format!("texture {{ {} }}{}", base(1.0), second_lobe(m, 0.0)),
+        Some(t) => {
+            let (ch, pre, post) = get(MapKind::Specular, t)?;
+            format!(
+                "texture {{ {pre}{}{post} texture_map {{ [0 {}] [1 {}] }} }}",
+                pattern(&ch.files[0]),
+                base(0.0),
+                base(ch.scale)
+            )
+        }
+    })
+}
+
+/// A written map file as a bilinear, linear pattern (`pov_maps`).
+fn pattern(file: &str) -> String {
+    format!("image_pattern {{ png \"{file}\" gamma 1.0 interpolate 2 }}")
+}
+
+/// How a pattern in POV-Ray's image space [0, 1]^2 lands on `shape` at
+/// scenefit's (u, v) x `scale` (docs/scene-format.md "Textures"): what
+/// goes before the pattern and what after. A sphere's and a mesh's
+/// `uv_mapping` are scenefit's (measured: within 0.03 % of phong); a
+/// plane and a quad are planar maps carried onto their axes (e_u, e_v;
+/// edge_u, edge_v) by a matrix; a box: None (refused).
+fn mapping(shape: &Shape, scale: [f64; 2]) -> Option<(String, String)> {
+    let sc = format!(
+        " scale <{}, {}, 1>",
+        num(1.0 / scale[0]),
+        num(1.0 / scale[1])
+    );
+    let frame = |u: Vec3, v: Vec3, n: Vec3, at: Vec3| {
+        let m: Vec<String> = [u, v, n, at]
+            .iter()
+            .flat_map(|x| pov(*x).map(num))
+            .collect();
+        format!("{sc} matrix <{}>", m.join(", "))
+    };
+    match *shape {
+        Shape::Sphere { .. } | Shape::Mesh { .. } => Some(("uv_mapping ".into(), sc)),
+        Shape::Plane { point, normal } => {
+            let (eu, ev) = crate::scene::texture::uv::plane_axes(V3::from(normal));
+            let n = V3::from(normal).normalized();
+            Some((
+                String::new(),
+                frame(eu.to_array(), ev.to_array(), n.to_array(), point),
+            ))
+        }
+        Shape::Quad {
+            corner,
+            edge_u,
+            edge_v,
+        } => {
+            let n = V3::from(edge_u).cross(V3::from(edge_v)).normalized();
+            Some((String::new(), frame(edge_u, edge_v, n.to_array(), corner)))
+        }
+        Shape::Box { .. } => None,
+    }
 }
 
 fn dot(a: Vec3, b: Vec3) -> f64 {

@@ -53,7 +53,8 @@ impl Process for PovRay {
         let program = discover::find("povray", &discover::apt_hint("povray"))?;
         let (cfg, dir) = session_dir(jobs, (RENDER_TIMEOUT, RENDER_TIMEOUT), &self.0)?;
         let version = version(&program);
-        let backend = PovBackend { program };
+        let maps = super::pov_maps::PovMaps::new(dir.path());
+        let backend = PovBackend { program, maps };
         confine(dir.path())?;
         Ok(Box::new(ExternalSession::one_shot(
             Box::new(backend),
@@ -66,6 +67,8 @@ impl Process for PovRay {
 
 struct PovBackend {
     program: PathBuf,
+    /// the texture maps written into the run directory (`pov_maps`)
+    maps: super::pov_maps::PovMaps,
 }
 
 impl OneShotBackend for PovBackend {
@@ -74,7 +77,7 @@ impl OneShotBackend for PovBackend {
     }
 
     fn scene_text(&self, scene: &Scene) -> std::result::Result<String, String> {
-        let text = pov_sdl::sdl(scene)?;
+        let text = pov_sdl::sdl_with(scene, &|t, k| self.maps.get(t, k))?;
         only_version_directive(&text)?;
         Ok(text)
     }

@@ -48,17 +48,22 @@ fn scene_for(field: &str) -> Scene {
         "`render.max_depth` above 254" => s.render.max_depth = 255,
         "`material.diffuse_f90` (other than 1)" => m.diffuse_f90 = Some(0.5),
         "`material.albedo_map`" => m.albedo_map = Some("map.png".into()),
-        "`material.color_map`" => m.color_map = Some(TextureRef::File("t.png".into())),
-        "`material.specular_map`" => m.specular_map = Some(TextureRef::File("t.png".into())),
+        "a `specular_map` with `specular2` > 0" => {
+            m.specular_map = Some(TextureRef::File("t.png".into()));
+            m.specular2 = Some(0.2);
+        }
         "`material.shininess_map`" => m.shininess_map = Some(TextureRef::File("t.png".into())),
         "`material.normal_map`" => m.normal_map = Some(TextureRef::File("t.png".into())),
-        "a texture map on a `box`, or on a material with `transmission` > 0" => {
+        "a texture map on a `box`" => {
             m.color_map = Some(TextureRef::File("t.png".into()));
-            m.transmission = 0.5;
             s.objects[0].shape = serde_json::from_value(
                 serde_json::json!({"type": "box", "min": [0.0, 0.0, 0.0], "max": [1.0, 1.0, 1.0]}),
             )
             .unwrap();
+        }
+        "a texture map on a material with `transmission` > 0" => {
+            m.color_map = Some(TextureRef::File("t.png".into()));
+            m.transmission = 0.5;
         }
         "`camera.fy` other than `camera.fx` (a pinhole's)" => {
             s.camera = serde_json::from_value(serde_json::json!({"type": "pinhole",

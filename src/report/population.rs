@@ -13,7 +13,7 @@
 //! image of a diffuse surface shows, so intensity and albedo spread along a
 //! hyperbola, negatively correlated, while their product stays put.
 
-use crate::fit::{self, Checkpoint};
+use crate::fit;
 use crate::rundir::{RunDir, CHECKPOINT};
 use crate::scene::field::{LightField, MaterialField};
 use crate::scene::{Field, ParamSpace, Value};
@@ -56,7 +56,7 @@ pub fn load(dir: &Path) -> Result<Population, String> {
     if !run.file(CHECKPOINT).is_file() {
         return Err(format!("no {CHECKPOINT}"));
     }
-    let c = Checkpoint::load(&run).map_err(|e| e.to_string())?;
+    let c = fit::load_state(&run).map_err(|e| e.to_string())?;
     let p = c
         .population()
         .ok_or_else(|| format!("{CHECKPOINT} holds no population (the search keeps none)"))?;

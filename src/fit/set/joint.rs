@@ -13,7 +13,7 @@
 //! into one small dense system (~100 coordinates for 24 photographs).
 
 use super::shots::Shot;
-use super::state::SetState;
+use super::state::FitState;
 use super::{block_seed, varying, SetConfig};
 use crate::error::{Error, Result};
 use crate::fit::counted;
@@ -69,7 +69,7 @@ impl Layout {
         }
     }
 
-    fn pack(&self, state: &SetState) -> Vec<f64> {
+    fn pack(&self, state: &FitState) -> Vec<f64> {
         let mut x = state.shared.clone();
         for o in &state.own {
             x.extend_from_slice(o);
@@ -77,7 +77,7 @@ impl Layout {
         x
     }
 
-    fn unpack(&self, x: &[f64], state: &mut SetState) {
+    fn unpack(&self, x: &[f64], state: &mut FitState) {
         let ns = self.shared.dim();
         state.shared = x[..ns].to_vec();
         for (i, o) in self.own.iter().enumerate() {
@@ -244,7 +244,7 @@ fn fitness(shots: &[Shot], r: &[Residuals]) -> f64 {
 /// deviation after it. The state moves only to a point that rendered and
 /// scored better.
 pub fn run(
-    state: &mut SetState,
+    state: &mut FitState,
     shots: &[Shot],
     renderer: &dyn Renderer,
     config: &SetConfig,

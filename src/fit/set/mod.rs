@@ -23,12 +23,17 @@
 //! block (`state`), so `--resume` continues where the run stopped, to the
 //! result an uninterrupted run gives.
 
+pub(crate) mod driver;
 mod joint;
 mod outcome;
+pub(crate) mod phase;
 pub mod renders;
+mod resume;
+mod run;
+pub(crate) mod saved;
 mod setup;
 pub mod shots;
-mod state;
+pub(crate) mod state;
 
 pub use super::output::ShotResult;
 pub use crate::fit::counted;
@@ -38,18 +43,18 @@ pub use setup::SetConfig;
 use super::executor::{Halt, Offsets};
 use super::search_run::{halt_error, Logs, SearchRun};
 use super::{FitConfig, Observer};
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::fit::problem::ShotsProblem;
-use crate::fit::set::shots::Shot;
 use crate::metric::Deviation;
 use crate::optimize::{Search, Searcher, Start, StopRule};
 use crate::render::Renderer;
-use crate::rundir::{Kind, Mode, RunDir};
+use crate::rundir::RunDir;
 use crate::scene::{ParamSpace, Scene};
+use driver::drive;
+use run::{Plan, Run, Steps};
 use setup::{block_seed, varying};
-use state::{SetState, Within};
-use std::path::Path;
-use std::time::Instant;
+pub use shots::Shot;
+use state::{FitState, Within};
 
 /// Relative improvement of a round below which the blocks stop.
 const ROUND_TOLERANCE: f64 = 0.01;
@@ -93,29 +98,9 @@ fn block_config(config: &FitConfig, dim: usize, seed: u64) -> FitConfig {
     c
 }
 
-/// Runs a set fit in the run directory `dir` (opened in the fit's mode).
-pub fn run(
-    scene: &Scene,
-    shots: &[Shot],
-    renderer: &dyn Renderer,
-    config: &SetConfig,
-    dir: &Path,
-    observer: &mut dyn Observer,
-) -> Result<SetOutcome> {
-    let run_dir = RunDir::open_as(dir, config.fit.mode, Kind::Set)?;
-    for s in shots {
-        run_dir.refuse_overwritten_input(&s.entry.target, &format!("shot {}'s target", s.name))?;
-        if let Some(m) = &s.entry.mask {
-            run_dir.refuse_overwritten_input(m, &format!("shot {}'s mask", s.name))?;
-        }
-    }
-    for (what, p) in &config.fit.inputs {
-        run_dir.refuse_overwritten_input(p, what)?;
-    }
-    run_in(scene, shots, renderer, config, Some(&run_dir), observer)
-}
-
-/// Runs a set fit, in a run directory or (None) in memory only.
+/// Runs a set fit, in a run directory (opened by `driver::open`) or
+/// (None) in memory only: the one fit path (`driver`) with the set's
+/// blocks.
 pub fn run_in(
     scene: &Scene,
     shots: &[Shot],
@@ -124,78 +109,73 @@ pub fn run_in(
     dir: Option<&RunDir>,
     observer: &mut dyn Observer,
 ) -> Result<SetOutcome> {
-    let space = check_inputs(scene, shots, config)?;
-    let mut state = match (dir, config.fit.mode) {
-        (Some(d), Mode::Resume) => SetState::resume(d, scene, shots, renderer, config, &space)?,
-        _ => SetState::start(scene, shots, renderer, config, &space),
-    };
-    let plan = plan(&space, shots, config);
-    let started = Instant::now();
-    let before = state.seconds;
-    let mut cleared = config.fit.mode != Mode::Overwrite;
-    let mut logs = None;
-    let mut save = |state: &mut SetState| -> Result<()> {
-        state.seconds = before + started.elapsed().as_secs_f64();
-        dir.map_or(Ok(()), |d| state.save(d))
-    };
-    // A fresh run is resumable from its start (an overwriting one once
-    // the earlier run's files are gone: its first save).
-    if config.fit.mode == Mode::Fresh {
-        save(&mut state)?;
+    drive(
+        &Blocks, scene, shots, renderer, config, dir, false, observer,
+    )
+}
+
+/// A step of the alternation.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Block {
+    Own,
+    Shared,
+    /// Every coordinate at once, by Levenberg–Marquardt (`joint`).
+    Joint,
+}
+
+/// A set's plan: its blocks.
+pub struct Blocks;
+
+impl Plan for Blocks {
+    type Step = Block;
+    type Outcome = SetOutcome;
+
+    fn steps(&self, run: &Run) -> Result<Vec<Block>> {
+        Ok(plan(&run.space, run.shots, run.config))
     }
-    while state.blocks_done < plan.len() {
-        let block = plan[state.blocks_done];
-        let mut clear = || -> Result<()> {
-            if !cleared {
-                if let Some(d) = dir {
-                    d.clear()?;
-                }
-                cleared = true;
-            }
-            Ok(())
-        };
-        let mut steps = Steps {
-            clear: &mut clear,
-            save: &mut save,
-            logs: &mut logs,
-        };
+
+    /// Runs a block and records it: the set's deviation after it, the
+    /// next block (straight to the joint block, if there is one, once a
+    /// round has converged).
+    fn step(
+        &self,
+        run: &Run,
+        state: &mut FitState,
+        block: Block,
+        plan: &[Block],
+        observer: &mut dyn Observer,
+        io: &mut Steps,
+    ) -> Result<Option<SetOutcome>> {
+        let (shots, renderer, config, space, dir) =
+            (run.shots, run.renderer, run.config, &run.space, run.dir);
         let total = match block {
-            Block::Own => own_block(&mut state, shots, renderer, config, &space, dir, &mut steps)?,
-            Block::Shared => shared_block(
-                &mut state, shots, renderer, config, &space, observer, dir, &mut steps,
-            )?,
-            Block::Joint => joint::run(&mut state, shots, renderer, config, &space, steps.clear)?,
+            Block::Own => own_block(state, shots, renderer, config, space, dir, io)?,
+            Block::Shared => {
+                shared_block(state, shots, renderer, config, space, observer, dir, io)?
+            }
+            Block::Joint => joint::run(state, shots, renderer, config, space, io.clear)?,
         };
         state.within = Within::default();
         state.history.push(total);
         state.blocks_done += 1;
         if block == Block::Own && converged(&state.history) {
-            // Straight to the joint block, if there is one.
             state.blocks_done = plan.len() - usize::from(plan.last() == Some(&Block::Joint));
         }
-        save(&mut state)?;
+        (io.save)(state)?;
+        Ok(None)
     }
-    outcome::finish(&state, scene, shots, renderer, config, &space, dir)
-}
 
-/// What a block calls besides its search: `clear` once it is ready to
-/// write (an overwriting run removes the earlier run's files then), `save`
-/// after each step it has finished (the state written, when there is a
-/// run directory).
-struct Steps<'a> {
-    clear: &'a mut dyn FnMut() -> Result<()>,
-    save: &'a mut dyn FnMut(&mut SetState) -> Result<()>,
-    /// progress.txt and failures.log, opened by the first shared block.
-    logs: &'a mut Option<Logs>,
-}
-
-/// A step of the alternation.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Block {
-    Own,
-    Shared,
-    /// Every coordinate at once, by Levenberg–Marquardt (`joint`).
-    Joint,
+    fn finish(&self, run: &Run, state: &FitState) -> Result<SetOutcome> {
+        outcome::finish(
+            state,
+            run.scene,
+            run.shots,
+            run.renderer,
+            run.config,
+            &run.space,
+            run.dir,
+        )
+    }
 }
 
 /// The blocks in order: own, shared, own, shared, own, … (`rounds` shared
@@ -228,36 +208,11 @@ fn converged(history: &[f64]) -> bool {
     n >= 3 && history[n - 3] - history[n - 1] < ROUND_TOLERANCE * history[n - 3]
 }
 
-/// What a set fit needs before anything starts; the scene's free space.
-fn check_inputs(scene: &Scene, shots: &[Shot], config: &SetConfig) -> Result<ParamSpace> {
-    let space = ParamSpace::from_scene(scene);
-    if space.is_empty() {
-        return Err(Error::Usage(
-            "the scene has no \"free\" parameters to fit".into(),
-        ));
-    }
-    for s in shots {
-        let (w, h) = s.target.image.dimensions();
-        if (w, h) != (scene.image.width, scene.image.height) {
-            return Err(Error::Usage(format!(
-                "shot {}: the target is {w}x{h} but the scene renders {}x{}",
-                s.name, scene.image.width, scene.image.height
-            )));
-        }
-    }
-    config
-        .fit
-        .de
-        .validate()
-        .map_err(|e| Error::Usage(e.to_string()))?;
-    Ok(space)
-}
-
 /// Fits each photograph's own parameters with the shared ones held,
 /// saving after each photograph (a resumed block skips those done); the
 /// set's deviation after it.
 fn own_block(
-    state: &mut SetState,
+    state: &mut FitState,
     shots: &[Shot],
     renderer: &dyn Renderer,
     config: &SetConfig,
@@ -294,7 +249,7 @@ fn own_block(
 /// Photograph `i`'s own parameters fitted with the shared ones held, from
 /// the seed of this block and photograph; its deviation after.
 fn own_fit(
-    state: &mut SetState,
+    state: &mut FitState,
     i: usize,
     shot: &Shot,
     renderer: &dyn Renderer,
@@ -302,7 +257,7 @@ fn own_fit(
     space: &ParamSpace,
 ) -> Result<Deviation> {
     let own = shot.own_space(space);
-    let base = state.shot_scene(i, shot, &space.shared(), &own);
+    let base = state.shot_scene(i, &shot.scene, &space.shared(), &own);
     let t = &shot.target;
     if own.is_empty() {
         let img = crate::render::render_one(renderer, &base, 0)?;
@@ -315,7 +270,7 @@ fn own_fit(
     let seed = block_seed(config.fit.de.seed, state.blocks_done, i);
     let mut cfg = block_config(&config.fit, own.dim(), seed);
     cfg.start_radius = (state.blocks_done > 0 || config.warm).then_some(LATER_RADIUS);
-    let out = super::run_in_memory(&fit_scene, t, renderer, &cfg, &mut ())?;
+    let out = phase::run_one(&fit_scene, t, renderer, &cfg, None, &mut ())?;
     state.own[i] = own.unit_of(&out.scene);
     state.evaluations += out.result.evaluations;
     state.generations += out.result.generations;
@@ -327,7 +282,7 @@ fn own_fit(
 /// own values held; the set's deviation after it.
 #[allow(clippy::too_many_arguments)]
 fn shared_block(
-    state: &mut SetState,
+    state: &mut FitState,
     shots: &[Shot],
     renderer: &dyn Renderer,
     config: &SetConfig,
@@ -361,7 +316,7 @@ fn shared_block(
     // A resumed block continues from its saved search.
     let mut search = state.within.search.take().unwrap_or_else(|| {
         let mut s = Searcher::new(shared.dim(), &cfg.de, start);
-        s.set_periods(crate::fit::periods(&shared));
+        s.set_periods(phase::periods(&shared));
         s
     });
     let run = SearchRun {
@@ -380,10 +335,6 @@ fn shared_block(
         config: &config.fit,
         dir,
     };
-    if search.evaluations() > 0 {
-        let (best, f) = search.best();
-        problem.adopt_best(best, f);
-    }
     if steps.logs.is_none() {
         *steps.logs = Some(Logs::open(dir, &config.fit)?);
     }

@@ -4,16 +4,17 @@
 //! best image per photograph, and shots.json (the photographs with
 //! absolute paths, for `diagnose`).
 
-use super::state::SetState;
+use super::state::FitState;
 use super::{varying, SetConfig, ShotResult};
 use crate::error::{Error, Result};
 use crate::fit::counted;
+use crate::fit::output::Written;
 use crate::fit::set::shots::{Shot, ShotsFile, FORMAT};
 use crate::fit::{render_seed, FitResult};
 use crate::metric::{deviation, deviation_levels, Deviation};
 use crate::raster::Image;
 use crate::render::Renderer;
-use crate::rundir::{shot_best_name, RunDir, FITTED_SCENE, RESULT, SHOTS};
+use crate::rundir::{shot_best_name, RunDir};
 use crate::scene::{ParamSpace, Scene};
 
 /// One photograph's fit, in memory.
@@ -38,7 +39,7 @@ pub struct SetOutcome {
 
 /// Renders every photograph at the final values, and writes the outputs.
 pub fn finish(
-    state: &SetState,
+    state: &FitState,
     scene: &Scene,
     shots: &[Shot],
     renderer: &dyn Renderer,
@@ -50,7 +51,7 @@ pub fn finish(
     let scenes: Vec<Scene> = shots
         .iter()
         .enumerate()
-        .map(|(i, s)| state.shot_scene(i, s, &shared, &s.own_space(space)))
+        .map(|(i, s)| state.shot_scene(i, &s.scene, &shared, &s.own_space(space)))
         .collect();
     let outs = render_final(scenes, shots, renderer, config, space, state)?;
     let parts: Vec<(Deviation, usize)> = outs
@@ -97,7 +98,7 @@ pub fn finish(
 /// values held at theirs then. None after a joint block, which moves the
 /// shared values on from where that Jacobian was taken.
 fn identifiability(
-    state: &SetState,
+    state: &FitState,
     shared: &ParamSpace,
     config: &SetConfig,
 ) -> Option<crate::fit::Uncertainty> {
@@ -115,7 +116,7 @@ fn render_final(
     renderer: &dyn Renderer,
     config: &SetConfig,
     space: &ParamSpace,
-    state: &SetState,
+    state: &FitState,
 ) -> Result<Vec<ShotOutcome>> {
     let images = super::renders::render_shots(
         renderer,
@@ -170,11 +171,8 @@ fn precise(outs: &[ShotOutcome], shots: &[Shot]) -> Option<Deviation> {
     Some(Deviation::pooled(&parts))
 }
 
-/// The set's files; result.json last, so that it means the rest is there.
+/// The set's files, through the one writer (`fit::output`).
 fn write(dir: &RunDir, outcome: &SetOutcome, shots: &[Shot]) -> Result<()> {
-    for o in &outcome.shots {
-        dir.write_image(&shot_best_name(&o.result.name), &o.image)?;
-    }
     let file = ShotsFile {
         format: FORMAT.into(),
         shots: shots
@@ -187,9 +185,18 @@ fn write(dir: &RunDir, outcome: &SetOutcome, shots: &[Shot]) -> Result<()> {
             })
             .collect(),
     };
-    dir.write_json(SHOTS, &file)?;
-    dir.write_json(FITTED_SCENE, &outcome.scene)?;
-    dir.write_json(RESULT, &outcome.result)
+    let images = outcome
+        .shots
+        .iter()
+        .map(|o| (shot_best_name(&o.result.name), &o.image))
+        .collect();
+    let written = Written {
+        images,
+        shots: Some(&file),
+        scene: &outcome.scene,
+        result: &outcome.result,
+    };
+    crate::fit::output::write(dir, &written)
 }
 
 fn absolute(p: &std::path::Path) -> std::path::PathBuf {

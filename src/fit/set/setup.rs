@@ -29,6 +29,19 @@ pub struct SetConfig {
     pub spread: Vec<(String, f64)>,
 }
 
+impl SetConfig {
+    /// One photograph's fit run as `fit` says (no blocks, no rounds).
+    pub fn one(fit: FitConfig) -> SetConfig {
+        SetConfig {
+            fit,
+            rounds: 0,
+            warm: false,
+            joint: false,
+            spread: Vec::new(),
+        }
+    }
+}
+
 /// Every field a set's renders vary: the free parameters and the fields
 /// the shots' `set` fixes, with bounds that hold every shot's value (a
 /// renderer prepares for the range it will be asked to draw).

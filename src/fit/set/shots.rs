@@ -62,6 +62,24 @@ pub struct Shot {
 }
 
 impl Shot {
+    /// One photograph of `scene`, given on its own (`fit --target`): a
+    /// list of one.
+    pub fn one(scene: &Scene, target: FitTarget) -> Shot {
+        let entry = Entry {
+            name: "target".into(),
+            target: target.path.clone().unwrap_or_default(),
+            mask: None,
+            encoding: None,
+            set: Default::default(),
+        };
+        Shot {
+            name: entry.name.clone(),
+            scene: scene.clone(),
+            target,
+            entry,
+        }
+    }
+
     /// This shot's own free parameters: the per-shot ones its `set` does
     /// not fix.
     pub fn own_space(&self, space: &ParamSpace) -> ParamSpace {

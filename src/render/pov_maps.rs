@@ -1,0 +1,86 @@
+//! The texture maps POV-Ray reads (`pov_sdl.rs`): each map decoded as
+//! scenefit decodes it (`scene::texture`), its `range` applied, written
+//! once per session into the run directory as 16-bit grey PNGs, one per
+//! channel used, each value divided by the map's largest (that factor
+//! goes into the SDL), so that POV-Ray's `image_pattern` (`gamma 1.0`,
+//! bilinear) reads scenefit's linear values to 1/65535. The SDL names
+//! only these files (`m0r.png`, ...), never a path from the scene.
+
+use crate::scene::texture::{self, Encoding, MapKind, TextureRef};
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use std::sync::{Arc, Mutex};
+
+/// A map as written: the files of its channels (R, G, B for a colour
+/// map; R alone otherwise) and the factor they were divided by.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Channels {
+    pub files: Vec<String>,
+    pub scale: f64,
+}
+
+/// (file, encoding, range bits, channels): what decides a written map.
+type Key = (String, Encoding, [u64; 2], usize);
+
+/// The maps written into one run directory.
+pub struct PovMaps {
+    dir: PathBuf,
+    written: Mutex<HashMap<Key, Arc<Channels>>>,
+}
+
+impl PovMaps {
+    pub fn new(dir: &Path) -> PovMaps {
+        PovMaps {
+            dir: dir.to_path_buf(),
+            written: Mutex::new(HashMap::new()),
+        }
+    }
+
+    /// The files POV-Ray reads for map `t` of kind `kind`, written on
+    /// first use in this session.
+    pub fn get(&self, t: &TextureRef, kind: MapKind) -> Result<Arc<Channels>, String> {
+        let channels = if kind == MapKind::Color { 3 } else { 1 };
+        let [lo, hi] = t.range();
+        let enc = t.encoding(kind);
+        let key = (
+            t.file().to_string(),
+            enc,
+            [lo.to_bits(), hi.to_bits()],
+            channels,
+        );
+        let mut written = self.written.lock().expect("pov maps");
+        if let Some(c) = written.get(&key) {
+            return Ok(c.clone());
+        }
+        let texels = texture::get(Path::new(t.file()), enc)
+            .map_err(|e| format!("{}: {}: {e}", kind.key(), t.file()))?;
+        let values: Vec<f64> = texels
+            .values
+            .iter()
+            .map(|&v| lo + v as f64 * (hi - lo))
+            .collect();
+        let largest = values.iter().fold(0.0f64, |a, &b| a.max(b));
+        let scale = if largest > 0.0 { largest } else { 1.0 };
+        let n = written.len();
+        let mut files = Vec::new();
+        for c in 0..channels {
+            let name = format!("m{n}{}.png", ['r', 'g', 'b'][c]);
+            let px: Vec<u16> = values
+                .chunks_exact(3)
+                .map(|p| ((p[c] / scale).clamp(0.0, 1.0) * 65535.0).round() as u16)
+                .collect();
+            let img = image::ImageBuffer::<image::Luma<u16>, _>::from_raw(
+                texels.width,
+                texels.height,
+                px,
+            )
+            .ok_or("internal error: texel count")?;
+            img.save(self.dir.join(&name))
+                .map_err(|e| format!("{}: writing {name} for POV-Ray: {e}", kind.key()))?;
+            files.push(name);
+        }
+        let c = Arc::new(Channels { files, scale });
+        written.insert(key, c.clone());
+        Ok(c)
+    }
+}
