@@ -161,6 +161,16 @@ fn a_blend_imported_renders_as_blender_renders_it_and_round_trips() {
     ));
     let again = loaded(&d.join("again/imp.json"), &d.join("again"), d);
     same(&loaded(&d.join("imp.json"), d, d), &again, "scene");
+    // and the same JSON as written: no field added with its default value
+    let (first, second) = (json(&d.join("imp.json")), json(&d.join("again/imp.json")));
+    for (a, b) in first["objects"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .zip(second["objects"].as_array().unwrap())
+    {
+        same(&a["material"], &b["material"], "material as written");
+    }
     // the meshes: the same positions, UVs and triangles (normals pass
     // through Blender's custom normals, stored at lower precision)
     for o in scene["objects"].as_array().unwrap() {
