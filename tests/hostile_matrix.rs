@@ -298,6 +298,20 @@ const INPUTS: &[Input] = &[
         output: "imp.json",
     },
     Input {
+        label: "import (Mitsuba)",
+        args: &["import", "u.xml", "-o", "imp.json"],
+        file: "u.xml",
+        kind: Kind::Text,
+        output: "imp.json",
+    },
+    Input {
+        label: "export --to mitsuba",
+        args: &["export", "s.json", "--to", "mitsuba", "-o", "outx"],
+        file: "s.json",
+        kind: Kind::Json,
+        output: "outx",
+    },
+    Input {
         label: "export --to blender",
         args: &["export", "s.json", "--to", "blender", "-o", "out.blend"],
         file: "s.json",
@@ -523,6 +537,11 @@ fn fixture() -> tempfile::TempDir {
     );
     let yml = "%YAML:1.0\n---\nimage_width: 16\nimage_height: 12\ncamera_matrix: !!opencv-matrix\n   rows: 3\n   cols: 3\n   dt: d\n   data: [ 20., 0., 7.5, 0., 20., 5.5, 0., 0., 1. ]\ndistortion_coefficients: !!opencv-matrix\n   rows: 1\n   cols: 5\n   dt: d\n   data: [ 0., 0., 0., 0., 0. ]\nrvec: !!opencv-matrix\n   rows: 3\n   cols: 1\n   dt: d\n   data: [ 3.3, 0., 0. ]\ntvec: !!opencv-matrix\n   rows: 3\n   cols: 1\n   dt: d\n   data: [ 0., 0.5, 5.3 ]\n";
     write(&p.join("p1.yml"), yml.as_bytes());
+    // a Mitsuba scene: only its stand-ins are read
+    write(
+        &p.join("u.xml"),
+        b"<scene version=\"3.0.0\"><emitter type=\"point\"><point name=\"position\" x=\"0\" y=\"2\" z=\"2\"/></emitter></scene>\n",
+    );
     // a .blend's signature and a block: only its stand-ins are read
     write(
         &p.join("u.blend"),
