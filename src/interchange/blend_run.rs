@@ -4,13 +4,14 @@
 //! scene build the export reuses, and scene_common / jsonlines) written
 //! into a private temporary directory, Blender started as the backend
 //! starts it plus `--disable-autoexec` (a .blend's own Python never runs),
-//! its output kept for the error message, killed after a time limit.
+//! run by the one interchange runner (`script_run`: a time limit, the
+//! process group killed), its output read for the script's own error.
 
+use super::script_run;
 use crate::error::{Error, Result};
+use crate::exec::process::CommandSpec;
 use std::ffi::OsString;
 use std::path::Path;
-use std::process::{Command, Stdio};
-use std::time::{Duration, Instant};
 
 /// The scripts and the modules they import, as shipped.
 const FILES: &[(&str, &str)] = &[
@@ -30,10 +31,6 @@ const FILES: &[(&str, &str)] = &[
     ),
 ];
 
-/// Longest a job may take: Blender's start-up plus reading or writing a
-/// large scene.
-const TIME_LIMIT: Duration = Duration::from_secs(900);
-
 /// The line a script prints before a user's error (a file it cannot map),
 /// to be shown as scenefit's one-line error.
 const USER_ERROR: &str = "scenefit-error: ";
@@ -44,48 +41,37 @@ const USER_ERROR: &str = "scenefit-error: ";
 pub fn run(dir: &Path, blend: Option<&Path>, script: &str, args: &[OsString]) -> Result<()> {
     let program =
         crate::exec::discover::find("blender", &crate::exec::discover::apt_hint("blender"))?;
-    for (name, text) in FILES {
-        crate::fsio::write_atomic(&dir.join(name), text.as_bytes())?;
-    }
-    let log = dir.join("blender.log");
-    let out = std::fs::File::create(&log).map_err(|e| Error::io(&log, e))?;
-    let err = out.try_clone().map_err(|e| Error::io(&log, e))?;
-    let mut cmd = Command::new(program);
-    cmd.arg("-b");
+    script_run::write_files(dir, FILES)?;
+    let mut spec = CommandSpec::new(program).arg("-b");
     if let Some(b) = blend {
-        cmd.arg(b);
+        spec = spec.arg(b);
     }
-    cmd.args(["--factory-startup", "--disable-autoexec", "-noaudio"])
+    let spec = spec
+        .args(["--factory-startup", "--disable-autoexec", "-noaudio"])
         .args(["--python-exit-code", "1", "-P"])
         .arg(dir.join(script))
         .arg("--")
-        .args(args)
-        .current_dir(dir)
-        .env("TMPDIR", dir)
-        .stdin(Stdio::null())
-        .stdout(out)
-        .stderr(err);
-    let ok = wait(cmd)?;
-    let text = crate::input::read_tail(&log, 64 << 10)
-        .map(|b| String::from_utf8_lossy(&b).into_owned())
-        .unwrap_or_default();
+        .args(args.iter().cloned())
+        .cwd(dir)
+        .env("TMPDIR", dir);
+    let ran = script_run::run(&spec, script_run::TIME_LIMIT)?;
+    let text = &ran.text;
     if let Some(line) = text.lines().rev().find_map(|l| l.strip_prefix(USER_ERROR)) {
         return Err(Error::Usage(line.trim().to_string()));
     }
-    if let (Some(b), Some(why)) = (blend, unreadable(&text)) {
+    if let (Some(b), Some(why)) = (blend, unreadable(text)) {
         return Err(Error::Usage(format!(
             "{}: Blender cannot read it ({why}); expected a .blend file saved by Blender",
             b.display()
         )));
     }
-    if ok {
-        return Ok(());
+    match ran.failure {
+        None => Ok(()),
+        Some(failure) => Err(Error::Run(format!(
+            "Blender running {script} {failure}: {}",
+            script_run::last_lines(text, 3)
+        ))),
     }
-    let tail: Vec<&str> = text.lines().filter(|l| !l.trim().is_empty()).collect();
-    let last = tail[tail.len().saturating_sub(3)..].join(" | ");
-    Err(Error::Run(format!(
-        "Blender failed running {script}: {last}"
-    )))
 }
 
 /// Blender's reason for not loading the file it was given, from its log
@@ -96,32 +82,4 @@ fn unreadable(log: &str) -> Option<String> {
         .find(|l| l.contains("Failed to read blend file") || l.contains("Cannot read file"))?;
     let why = line.rsplit(": ").next().unwrap_or(line).trim();
     Some(why.to_string())
-}
-
-/// Starts `cmd` in a process group of its own and waits at most
-/// TIME_LIMIT; true when it exited with status 0.
-fn wait(mut cmd: Command) -> Result<bool> {
-    use std::os::unix::process::CommandExt;
-    cmd.process_group(0);
-    let mut child = cmd
-        .spawn()
-        .map_err(|e| Error::Run(format!("cannot start blender: {e}")))?;
-    let start = Instant::now();
-    loop {
-        match child.try_wait() {
-            Ok(Some(status)) => return Ok(status.success()),
-            Ok(None) if start.elapsed() < TIME_LIMIT => {
-                std::thread::sleep(Duration::from_millis(50))
-            }
-            _ => {
-                // SAFETY: kill(2) on the group this function started.
-                unsafe { libc::kill(-(child.id() as i32), libc::SIGKILL) };
-                let _ = child.wait();
-                return Err(Error::Run(format!(
-                    "Blender took over {} s; killed",
-                    TIME_LIMIT.as_secs()
-                )));
-            }
-        }
-    }
 }

@@ -17,6 +17,7 @@ pub mod mitsuba_import;
 pub mod opencv_yaml;
 pub mod python_run;
 pub mod scene_files;
+pub mod script_run;
 pub mod shots_out;
 
 use crate::error::{Error, Result};

@@ -1,13 +1,14 @@
-//! One run of a Python script of workers/ for an import or export: the
-//! script and the modules it imports written into a private temporary
-//! directory, run once, its answer read from a small JSON file it writes
+//! One run of a Python script of workers/ for an import or export, by the
+//! one interchange runner (`script_run`: a private directory, a time
+//! limit, the process group killed); its answer read from a small JSON file it writes
 //! (`{"ok": true, ...}` or `{"ok": false, "error": "...", "user": bool}`),
 //! so that nothing the renderer's package prints can be taken for it.
 
+use super::script_run;
 use crate::error::{Error, Result};
+use crate::exec::process::CommandSpec;
 use std::ffi::OsString;
 use std::path::Path;
-use std::process::Command;
 
 /// The modules the Mitsuba scripts import, as shipped in workers/.
 pub const MITSUBA_MODULES: &[(&str, &str)] = &[
@@ -39,19 +40,16 @@ pub fn run(
         .prefix("scenefit-interchange-")
         .tempdir()
         .map_err(|e| Error::Run(format!("{what}: cannot make a temporary directory: {e}")))?;
-    for (name, text) in modules.iter().chain(std::iter::once(&script)) {
-        let path = dir.path().join(name);
-        std::fs::write(&path, text).map_err(|e| Error::io(&path, e))?;
-    }
+    script_run::write_files(dir.path(), modules)?;
+    script_run::write_files(dir.path(), &[script])?;
     let answer = dir.path().join("answer.json");
-    let out = Command::new(python)
-        .current_dir(dir.path())
+    let spec = CommandSpec::new(python)
+        .cwd(dir.path())
         .arg(dir.path().join(script.0))
-        .args(args)
-        .arg(&answer)
-        .output()
-        .map_err(|e| Error::Run(format!("{what}: cannot run {}: {e}", python.display())))?;
-    let stderr = String::from_utf8_lossy(&out.stderr);
+        .args(args.iter().cloned())
+        .arg(&answer);
+    let ran = script_run::run(&spec, script_run::TIME_LIMIT)?;
+    let stderr = &ran.text;
     if stderr.contains("No module named 'mitsuba'") || stderr.contains("No module named 'drjit'") {
         return Err(Error::Usage(format!(
             "{what}: the mitsuba Python package is not installed for {}; install it with `python3 -m pip install mitsuba` or name another Python with --python",
@@ -59,13 +57,11 @@ pub fn run(
         )));
     }
     let bytes = crate::input::read_capped(&answer, MAX_ANSWER_BYTES).map_err(|_| {
-        let tail: Vec<&str> = stderr.lines().rev().take(3).collect();
-        let tail: Vec<&str> = tail.into_iter().rev().collect();
         Error::Run(format!(
-            "{what}: {} ended ({}) without an answer: {}",
+            "{what}: {} {} without an answer: {}",
             python.display(),
-            out.status,
-            tail.join(" / ")
+            ran.failure.as_deref().unwrap_or("exited 0"),
+            script_run::last_lines(stderr, 3)
         ))
     })?;
     let value: serde_json::Value = serde_json::from_slice(&bytes)
