@@ -20,7 +20,7 @@ const BOUND: f64 = 0.3;
 
 /// A diffuse scene whose four objects are each placed by a transform
 /// that no symmetry hides: a turn the wrong way moves their edges; with
-/// `mesh`, the example blob mesh posed too (Mitsuba refuses a posed mesh).
+/// `mesh`, the example blob mesh posed too.
 fn posed_scene(samples: u32, antialias: u32, mesh: bool) -> serde_json::Value {
     let mut s = diffuse_scene(samples, antialias);
     s["objects"] = serde_json::json!([
@@ -51,7 +51,7 @@ fn posed_scene(samples: u32, antialias: u32, mesh: bool) -> serde_json::Value {
 /// built-in tracer's (4x4 supersampled: edges area-averaged as the others'
 /// box filter does).
 fn posed_agreement(renderer: &str) -> f64 {
-    let mesh = renderer != "mitsuba";
+    let mesh = true;
     let scene = |v: &serde_json::Value| parse(&v.to_string(), "posed", &[]).unwrap();
     let phong = render_one(
         from_spec("phong").unwrap().as_ref(),

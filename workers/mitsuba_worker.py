@@ -84,7 +84,9 @@ objects
              normalize(edge_u x edge_v), origin corner + (edge_u+edge_v)/2.
   box     -> ``cube`` mesh whose vertices are set to center + half_size * unit cube.
   transform (an object's placement, scene_common.transform): its matrix times
-             the shape's to_world; for a box, applied to each vertex.
+             the shape's to_world; for a box, applied to each vertex; for a
+             mesh, to the file's vertices (normals by the inverse transpose),
+             written per candidate as a box's are.
 materials (d = diffuse, c = color, ks = specular, n = shininess, kr = reflection,
   kt = transmission)
   ks = ks2 = kr = kt = 0 -> ``twosided`` ``diffuse`` with reflectance d*c
@@ -783,7 +785,11 @@ class MitsubaBackend:
             if O["shape"] == "box":
                 v[key + ".vertex_positions"] = ("box", (O["center"], O["half"], O["transform"]))
             elif O["shape"] == "mesh":
-                pass  # drawn where the file puts it (a posed mesh is refused: pbr_fields.rs)
+                if O["transform"] is not None:
+                    # the file's vertices (and normals) as loaded, moved per candidate
+                    v[key + ".vertex_positions"] = ("mesh", (key, O["transform"]))
+                    if key + ".vertex_normals" in self.params:
+                        v[key + ".vertex_normals"] = ("mesh", (key, O["transform"]))
             else:
                 v[key + ".to_world"] = ("transform", O["to_world"])
             v.update(self.bsdf_values(key, O["material"]))
@@ -802,6 +808,8 @@ class MitsubaBackend:
             return mi.Vector3f(*value)
         if kind == "transform":
             return type(self.params[key])(mi.ScalarTransform4f([list(r) for r in value]))
+        if kind == "mesh":
+            return type(self.params[key])(self.posed(key, value[1]))
         if kind == "box":
             center, half, place = value
             unit = self.unit_cubes[key]
@@ -810,6 +818,31 @@ class MitsubaBackend:
                 pos = [x for k in range(0, len(pos), 3) for x in apply_point(place, pos[k:k + 3])]
             return type(self.params[key])(pos)
         raise AssertionError(kind)
+
+    def posed(self, key, place):
+        """A mesh's vertices (or normals) as the file gives them, moved by
+        the object's transform (4x4 row-major): Mitsuba's own transform of a
+        point, or of a normal by the inverse transpose, on the whole array."""
+        mi, dr = self.mi, self.dr
+        if mi.variant().startswith("scalar"):
+            return self.posed_scalar(key, place)
+        t = mi.Transform4f([list(r) for r in place])
+        if key.endswith(".vertex_normals"):
+            moved = dr.normalize(t @ dr.unravel(mi.Normal3f, self.mesh_files[key]))
+        else:
+            moved = t @ dr.unravel(mi.Point3f, self.mesh_files[key])
+        return dr.ravel(moved)
+
+    def posed_scalar(self, key, place):
+        """`posed` for scalar variants, whose arrays are plain lists of floats."""
+        flat = [float(x) for x in self.mesh_files[key]]
+        triples = [flat[k:k + 3] for k in range(0, len(flat), 3)]
+        if key.endswith(".vertex_normals"):
+            cof = cofactor3(place)
+            triples = [normalized(tuple(sum(cof[i][j] * n[j] for j in range(3)) for i in range(3))) for n in triples]
+        else:
+            triples = [apply_point(place, p) for p in triples]
+        return [x for t in triples for x in t]
 
     def write_values(self, values, force):
         params = self.params
@@ -841,10 +874,16 @@ class MitsubaBackend:
             raise SceneError("Mitsuba could not load the scene: %s" % str(e).strip())
         self.scene = scene
         self.params = mi.traverse(scene)
+        self.mesh_files = {}
         for i, O in enumerate(plan["objects"]):
             if O["shape"] == "box":
                 key = "O%d.vertex_positions" % i
                 self.unit_cubes[key] = [float(x) for x in self.params[key]]
+            elif O["shape"] == "mesh" and O["transform"] is not None:
+                for part in ("vertex_positions", "vertex_normals"):
+                    key = "O%d.%s" % (i, part)
+                    if key in self.params:
+                        self.mesh_files[key] = type(self.params[key])(self.params[key])
         self.write_values(self.plan_values(plan), force=True)
         self.frozen = self.freezable(plan)
         self.signature = signature
@@ -927,6 +966,24 @@ class MitsubaBackend:
         # one recording per spp value is expected; a new structure is a new
         # scene and a new frozen function, so the old recordings go with it
         return self.dr.freeze(render, limit=4, warn_after=100)
+
+
+def cofactor3(m):
+    """The cofactor matrix of the linear part of a 4x4 row-major affine
+    matrix: its inverse transpose times its determinant, which takes
+    normals (up to length, and orientation when the determinant is < 0)."""
+    a = [list(m[i][:3]) for i in range(3)]
+    sign = 1.0 if (a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1])
+                   - a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0])
+                   + a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0])) >= 0 else -1.0
+    return [[sign * (a[(i + 1) % 3][(j + 1) % 3] * a[(i + 2) % 3][(j + 2) % 3]
+                     - a[(i + 1) % 3][(j + 2) % 3] * a[(i + 2) % 3][(j + 1) % 3]) for j in range(3)]
+            for i in range(3)]
+
+
+def normalized(v):
+    n = norm(v)
+    return tuple(x / n for x in v) if n > 0 else v
 
 
 class PhaseTimer:

@@ -71,18 +71,6 @@ fn refusals(scene: &Scene, mitsuba: bool) -> Vec<Refusal> {
         }
     }
     for o in &scene.objects {
-        // Mitsuba's mesh loaders place the file's vertices once; moving
-        // them per candidate (as a box's are) is not written yet.
-        let posed = o
-            .transform
-            .as_ref()
-            .is_some_and(|t| *t != Default::default());
-        if mitsuba && posed && matches!(o.shape, crate::scene::Shape::Mesh { .. }) {
-            refuse(
-                format!("objects.{}.transform", o.name),
-                "a mesh with a transform is drawn by phong, povray and blender; apply the transform to the file, or use one of those",
-            );
-        }
         let m = &o.material;
         if m.albedo_map.is_some() {
             refuse(
