@@ -131,8 +131,8 @@ class Exporter(mitsuba_worker.MitsubaBackend):
 
 def describe_for_xml(ex, plan, names):
     """build_dict's description, with each object's and light's key its
-    scenefit name (the XML id), meshes copied beside the XML, boxes placed
-    by their to_world (the worker writes their vertices instead)."""
+    scenefit name (the XML id), meshes copied beside the XML and placed,
+    like boxes, by their to_world (the worker writes their vertices instead)."""
     objects = plan["objects"]
     # bsdf_dict is called per object by build_dict: name the textures after it
     original = ex.bsdf_dict
@@ -153,6 +153,9 @@ def describe_for_xml(ex, plan, names):
                 os.makedirs(os.path.join(ex.out, "meshes"), exist_ok=True)
                 shutil.copyfile(o["file"], os.path.join(ex.out, rel))
                 value["filename"] = rel
+                if o["transform"] is not None:
+                    # the loaders place the file's vertices (normals too) by to_world
+                    value["to_world"] = ex.T([list(r) for r in o["transform"]])
             elif o["shape"] == "box":
                 hx, hy, hz = o["half"]
                 place = mitsuba_worker.columns_matrix((hx, 0, 0), (0, hy, 0), (0, 0, hz), o["center"])
