@@ -16,8 +16,10 @@ pub fn export(scene_path: &Path, out: &Path) -> Result<()> {
     let scene = crate::scene::load(scene_path)?;
     let file = scene_path.display().to_string();
     refuse_undrawn(&scene, &file)?;
-    let value = serde_json::to_value(&scene)
+    let mut value = serde_json::to_value(&scene)
         .map_err(|e| Error::Run(format!("cannot serialise the scene: {e}")))?;
+    // the .blend carries each material as the user wrote it
+    crate::scene::written::drop_default_material_fields(&mut value);
     let dir = tempfile::Builder::new()
         .prefix("scenefit-export-")
         .tempdir()

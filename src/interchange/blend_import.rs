@@ -51,7 +51,7 @@ pub fn import(file: &Path, out: &Path, free: &[String]) -> Result<Vec<String>> {
         })
         .unwrap_or_default();
     let mut value = answer["scene"].take();
-    drop_default_material_fields(&mut value);
+    crate::scene::written::drop_default_material_fields(&mut value);
     let shown = out.display().to_string();
     // validated as the scene file it becomes (mesh paths relative to it)
     let mut scene = crate::scene::load::from_value(value.clone(), &shown)?;
@@ -119,28 +119,4 @@ fn output_place(file: &Path, out: &Path) -> Result<(std::path::PathBuf, String)>
         )));
     }
     Ok((dir, stem.to_string()))
-}
-
-/// Removes from every object's material the fields that hold their
-/// default value (the scene format's own defaults, read from `Material`),
-/// so that a scene exported to a .blend (whose materials travel as their
-/// full serialised form) imports as the JSON it came from, not the same
-/// scene with every default written out.
-fn drop_default_material_fields(scene: &mut serde_json::Value) {
-    let defaults = serde_json::from_value::<crate::scene::Material>(
-        serde_json::json!({"color": [0.0, 0.0, 0.0]}),
-    )
-    .ok()
-    .and_then(|m| serde_json::to_value(m).ok());
-    let Some(serde_json::Value::Object(defaults)) = defaults else {
-        return;
-    };
-    let Some(objects) = scene.get_mut("objects").and_then(|o| o.as_array_mut()) else {
-        return;
-    };
-    for material in objects.iter_mut().filter_map(|o| o.get_mut("material")) {
-        if let Some(fields) = material.as_object_mut() {
-            fields.retain(|k, v| k == "color" || defaults.get(k) != Some(v));
-        }
-    }
 }

@@ -20,6 +20,7 @@ pub mod texture;
 pub mod transform;
 pub mod types;
 pub mod validate;
+pub mod written;
 
 pub use field::{Field, Value};
 pub use load::{load, load_with, parse, Override};
