@@ -4,7 +4,7 @@
 //! carries rays into that frame and normals out of it — so that a free
 //! pose costs no rebuild.
 
-use super::accel::{Aabb, EPS};
+use super::accel::{Aabb, FaceHit, TriPoint, EPS};
 use super::bvh::Bvh;
 use crate::math::V3;
 use crate::scene::mesh::{self, Mesh};
@@ -129,9 +129,10 @@ impl TriMesh {
     /// The nearest hit: distance, the shading normal (not unit): the
     /// vertex normals interpolated, or the face normal, on the side of the
     /// face the ray meets, so that the tracer's front and back agree with
-    /// the geometry; and the face normal (not unit).
+    /// the geometry; the face normal (not unit); and the triangle and
+    /// barycentrics the walk found it at (what a texture is looked up by).
     #[inline]
-    pub fn hit(&self, o: V3, d: V3, t_max: f64) -> Option<(f64, V3, V3)> {
+    pub fn hit(&self, o: V3, d: V3, t_max: f64) -> Option<(f64, V3, V3, TriPoint)> {
         let mut uv = (0.0, 0.0);
         let (k, t) = self.bvh.nearest(o, d, t_max, |k, tb| {
             let (t, u, v) = self.tris[k].hit(o, d, tb)?;
@@ -139,30 +140,23 @@ impl TriMesh {
             Some(t)
         })?;
         // uv is the last accepted hit's, which is the nearest
+        let (u, v) = uv;
+        let at = TriPoint {
+            tri: self.bvh.order[k],
+            u,
+            v,
+        };
         let tri = &self.tris[k];
         let ng = tri.e1.cross(tri.e2);
         let Some(n) = self.normals.get(k) else {
-            return Some((t, ng, ng));
+            return Some((t, ng, ng, at));
         };
-        let (u, v) = uv;
         let ns = n[0] * (1.0 - u - v) + n[1] * u + n[2] * v;
         let ns = if ns.dot(ng) < 0.0 { -ns } else { ns };
         // a shading normal turned past the ray (or zero) would flip the
         // side the tracer shades: keep the face's there
         let same_side = (ns.dot(d) < 0.0) == (ng.dot(d) < 0.0) && ns.dot(ns) > 0.0;
-        Some((t, if same_side { ns } else { ng }, ng))
-    }
-
-    /// The nearest hit's triangle, numbered as in the file, and its
-    /// barycentric (u, v): where a texture is looked up (`texture.rs`).
-    pub fn locate(&self, o: V3, d: V3, t_max: f64) -> Option<(usize, f64, f64)> {
-        let mut uv = (0.0, 0.0);
-        let (k, _) = self.bvh.nearest(o, d, t_max, |k, tb| {
-            let (t, u, v) = self.tris[k].hit(o, d, tb)?;
-            uv = (u, v);
-            Some(t)
-        })?;
-        Some((self.bvh.order[k] as usize, uv.0, uv.1))
+        Some((t, if same_side { ns } else { ng }, ng, at))
     }
 
     /// True when any triangle is hit within (EPS, t_max).
@@ -273,16 +267,22 @@ impl Placed {
         }
     }
 
-    /// Distance, unit shading normal and unit face normal of the nearest hit.
+    /// The nearest hit: distance, unit shading normal, unit face normal
+    /// and where on the mesh.
     #[inline]
-    pub fn hit(&self, o: V3, d: V3, t_max: f64) -> Option<(f64, V3, V3)> {
+    pub fn hit(&self, o: V3, d: V3, t_max: f64) -> Option<FaceHit> {
         let (ol, dl) = self.local(o, d)?;
-        let (t, n, ng) = self.mesh.hit(ol, dl, t_max)?;
+        let (t, n, ng, at) = self.mesh.hit(ol, dl, t_max)?;
         let (n, ng) = match &self.place {
             Place::Moved(m) => (m.0.normal(n), m.0.normal(ng)),
             _ => (n, ng),
         };
-        Some((t, n.normalized(), ng.normalized()))
+        Some(FaceHit {
+            t,
+            n: n.normalized(),
+            face: ng.normalized(),
+            tri: Some(at),
+        })
     }
 
     /// A sphere holding the placed mesh: centre and radius. The transform
@@ -317,12 +317,6 @@ impl Placed {
                 self.mesh.reaches_above(V3::new(x, y, z), thr - b.dot(m))
             }
         }
-    }
-
-    /// [`TriMesh::locate`] for a world ray.
-    pub fn locate(&self, o: V3, d: V3, t_max: f64) -> Option<(usize, f64, f64)> {
-        let (ol, dl) = self.local(o, d)?;
-        self.mesh.locate(ol, dl, t_max)
     }
 
     #[inline]
