@@ -6,6 +6,7 @@
 
 use super::accel::{Aabb, FaceHit, TriPoint, EPS};
 use super::bvh::Bvh;
+use super::inner_ball::{self, Ball};
 use crate::math::V3;
 use crate::scene::mesh::{self, Mesh};
 use crate::scene::transform::Affine;
@@ -55,6 +56,8 @@ pub struct TriMesh {
     pub bounds: Aabb,
     /// A sphere holding every vertex: centre and radius.
     sphere: (V3, f64),
+    /// For a closed mesh, a ball inside it (`inner_ball.rs`).
+    ball: Option<Ball>,
 }
 
 impl TriMesh {
@@ -94,7 +97,7 @@ impl TriMesh {
             .iter()
             .map(|&v| (V3::from(v) - centre).length())
             .fold(0.0, f64::max);
-        TriMesh {
+        let mut t = TriMesh {
             tris,
             normals,
             bvh,
@@ -103,7 +106,31 @@ impl TriMesh {
                 hi: V3::from(hi),
             },
             sphere: (centre, radius),
-        }
+            ball: None,
+        };
+        let bounds = (t.bounds.lo, t.bounds.hi);
+        t.ball = inner_ball::find(&m.positions, &m.triangles, bounds, |o, d| t.crossings(o, d));
+        t
+    }
+
+    /// The number of triangles the ray o + t d meets (t > EPS).
+    fn crossings(&self, o: V3, d: V3) -> usize {
+        let mut n = 0;
+        self.bvh.any(o, d, f64::INFINITY, |k| {
+            n += self.tris[k].hit(o, d, f64::INFINITY).is_some() as usize;
+            false
+        });
+        n
+    }
+
+    /// True when the ray starts outside the bounding sphere by more than
+    /// rounding error and EPS along it: it is then outside the mesh, and
+    /// any crossing of the surface lies at t > EPS.
+    #[inline]
+    fn starts_outside(&self, o: V3, d: V3) -> bool {
+        let (c, r) = self.sphere;
+        let margin = 2.0 * EPS * d.length() + 1e-9 * (1.0 + r + c.length());
+        (o - c).length() > r + margin
     }
 
     /// True when some vertex x has x . m > thr: the mesh reaches above
@@ -159,9 +186,16 @@ impl TriMesh {
         Some((t, if same_side { ns } else { ng }, ng, at))
     }
 
-    /// True when any triangle is hit within (EPS, t_max).
+    /// True when any triangle is hit within (EPS, t_max). A ray from
+    /// outside that reaches the inner ball crosses the surface before it
+    /// (`inner_ball.rs`): blocked without a walk.
     #[inline]
     pub fn any(&self, o: V3, d: V3, t_max: f64) -> bool {
+        if let Some(ball) = &self.ball {
+            if inner_ball::reaches(ball, o, d, t_max) && self.starts_outside(o, d) {
+                return true;
+            }
+        }
         self.bvh
             .any(o, d, t_max, |k| self.tris[k].hit(o, d, t_max).is_some())
     }
@@ -323,5 +357,65 @@ impl Placed {
     pub fn any(&self, o: V3, d: V3, t_max: f64) -> bool {
         self.local(o, d)
             .is_some_and(|(ol, dl)| self.mesh.any(ol, dl, t_max))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A closed box of twelve triangles, stretched, as a mesh.
+    fn cube() -> Mesh {
+        let positions = (0..8)
+            .map(|k| {
+                [0, 1, 2].map(|a| (if k >> a & 1 == 0 { -1.0 } else { 1.0 }) * [1.0, 0.6, 0.3][a])
+            })
+            .collect();
+        let mut triangles = Vec::new();
+        for f in [
+            [0, 1, 3, 2],
+            [4, 6, 7, 5],
+            [0, 4, 5, 1],
+            [2, 3, 7, 6],
+            [0, 2, 6, 4],
+            [1, 5, 7, 3],
+        ] {
+            triangles.push([f[0], f[1], f[2]]);
+            triangles.push([f[0], f[2], f[3]]);
+        }
+        Mesh {
+            positions,
+            normals: Vec::new(),
+            texcoords: Vec::new(),
+            triangles,
+        }
+    }
+
+    /// The inner ball's shortcut answers every shadow ray as the walk
+    /// does: from points outside, inside and on the box, towards ends
+    /// inside, outside and beyond it; and it does answer many of them.
+    #[test]
+    fn the_inner_ball_blocks_exactly_what_the_walk_blocks() {
+        let t = TriMesh::new(&cube());
+        let ball = t.ball.expect("a closed box holds a ball");
+        assert!(ball.r > 0.29 && ball.r < 0.3, "{ball:?}");
+        let walk = |o: V3, d: V3, t_max: f64| {
+            t.bvh
+                .any(o, d, t_max, |k| t.tris[k].hit(o, d, t_max).is_some())
+        };
+        let mut short = 0;
+        for i in 0..2000 {
+            let f = i as f64;
+            let s = 0.3 + 2.0 * ((f * 0.37).sin() * 0.5 + 0.5);
+            let o = V3::new((f * 1.3).sin(), (f * 0.7).cos(), (f * 0.11).sin()) * s;
+            let to = V3::new((f * 0.53).cos(), (f * 0.91).sin(), (f * 0.29).cos()) * 0.4;
+            let d = (to - o).normalized();
+            for t_max in [0.2, (to - o).length(), 1e9] {
+                let shortcut = inner_ball::reaches(&ball, o, d, t_max) && t.starts_outside(o, d);
+                short += shortcut as usize;
+                assert_eq!(t.any(o, d, t_max), walk(o, d, t_max), "ray {i} {t_max}");
+            }
+        }
+        assert!(short > 500, "{short}");
     }
 }
