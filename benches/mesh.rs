@@ -6,8 +6,10 @@
 //! the floor free and (c) the ball's pose free (yaw and position; in both
 //! every camera and shadow ray is traced per candidate). Then, timed once:
 //! reading a 1,310,720-triangle mesh, a session on two threads (which
-//! builds its BVH) and a render. `cargo bench --bench mesh`; figures in
-//! docs/benchmarks.md.
+//! builds its BVH) and a render. Each timed case also prints its renders
+//! per CPU second (both threads' time summed), which a shared machine's
+//! load changes far less than the wall-clock rate. `cargo bench --bench
+//! mesh`; figures in docs/benchmarks.md.
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use rand::{Rng, SeedableRng};
@@ -117,11 +119,27 @@ fn bench(c: &mut Criterion) {
             group.bench_function(format!("{what}/{name}"), |b| {
                 b.iter(|| session.render_batch(&scenes, 0))
             });
+            // renders per CPU second besides: on a shared machine the
+            // wall-clock rate above says how busy the machine was
+            let (t, c) = (std::time::Instant::now(), cpu());
+            let mut n = 0;
+            while n < 3 || t.elapsed().as_secs_f64() < 1.0 {
+                session.render_batch(&scenes, 0);
+                n += 1;
+            }
+            eprintln!(
+                "{what}/{name}: {:.0} renders per CPU second",
+                (n * scenes.len()) as f64 / (cpu() - c)
+            );
         }
     }
     group.finish();
-    // reading, checking and building the BVH of 1.3 M triangles, once
-    let p = dir.path().join("ico8.ply");
+    big_mesh(dir.path());
+}
+
+/// Reading, checking and building the BVH of 1.3 M triangles, once.
+fn big_mesh(dir: &Path) {
+    let p = dir.join("ico8.ply");
     icosphere(&p, 8, [0.0, 0.5, 0.0], 0.5);
     let t = std::time::Instant::now();
     scenefit::scene::mesh::read(&p).unwrap();
@@ -134,13 +152,6 @@ fn bench(c: &mut Criterion) {
     // ... the session (two threads) builds the BVH (once per process) and
     // traces the camera rays; a render then shades them. Wall and CPU
     // seconds both: on a shared machine the wall time says little.
-    let cpu = || {
-        // SAFETY: getrusage only writes the struct it is given.
-        let mut u: libc::rusage = unsafe { std::mem::zeroed() };
-        unsafe { libc::getrusage(libc::RUSAGE_SELF, &mut u) };
-        let s = |t: libc::timeval| t.tv_sec as f64 + t.tv_usec as f64 * 1e-6;
-        s(u.ru_utime) + s(u.ru_stime)
-    };
     let (t, c) = (std::time::Instant::now(), cpu());
     let mut session = from_spec("phong")
         .unwrap()
@@ -155,6 +166,15 @@ fn bench(c: &mut Criterion) {
         "1310720 triangles: file read and checked in {read:.2?}; session on 2 threads (BVH built, camera rays traced) {build:.2?} wall, {build_cpu:.2} s CPU; a render {:.2?}",
         t.elapsed()
     );
+}
+
+/// CPU seconds this process has used, over all its threads.
+fn cpu() -> f64 {
+    // SAFETY: getrusage only writes the struct it is given.
+    let mut u: libc::rusage = unsafe { std::mem::zeroed() };
+    unsafe { libc::getrusage(libc::RUSAGE_SELF, &mut u) };
+    let s = |t: libc::timeval| t.tv_sec as f64 + t.tv_usec as f64 * 1e-6;
+    s(u.ru_utime) + s(u.ru_stime)
 }
 
 criterion_group!(benches, bench);

@@ -52,18 +52,44 @@ impl Aabb {
     }
 }
 
+/// Where on a mesh a hit lies: its triangle, numbered as in the file,
+/// and the barycentric (u, v) of the hit on it (weights of the second and
+/// third corners), from the walk that found the hit: what a texture is
+/// looked up by (`texture.rs`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TriPoint {
+    pub tri: u32,
+    pub u: f64,
+    pub v: f64,
+}
+
+/// The nearest hit of a ray on one primitive: distance, unit normal (the
+/// shading one), unit face normal and, on a mesh, where on it.
+#[derive(Clone, Copy, Debug)]
+pub struct FaceHit {
+    pub t: f64,
+    pub n: V3,
+    pub face: V3,
+    pub tri: Option<TriPoint>,
+}
+
 /// What the tracer asks of a primitive. Rays are o + t d with d unit;
 /// hits count in (EPS, t_max) (`geometry::EPS`).
 pub trait Intersect {
     /// Distance and unit geometric normal of the nearest hit.
     fn hit(&self, o: V3, d: V3, t_max: f64) -> Option<(f64, V3)>;
 
-    /// The nearest hit with the face's own normal besides: distance, unit
-    /// normal (the shading one), unit face normal. The same normal twice
-    /// by default: only a mesh's two differ.
+    /// The nearest hit with the face's own normal besides (`FaceHit`).
+    /// The same normal twice and no triangle by default: only a mesh's
+    /// two normals differ, and only a mesh has triangles.
     #[inline(always)]
-    fn hit_face(&self, o: V3, d: V3, t_max: f64) -> Option<(f64, V3, V3)> {
-        self.hit(o, d, t_max).map(|(t, n)| (t, n, n))
+    fn hit_face(&self, o: V3, d: V3, t_max: f64) -> Option<FaceHit> {
+        self.hit(o, d, t_max).map(|(t, n)| FaceHit {
+            t,
+            n,
+            face: n,
+            tri: None,
+        })
     }
 
     /// A shadow ray's test: any hit at all?
@@ -94,8 +120,8 @@ impl Accel {
     }
 
     /// The nearest hit within (EPS, t_max) among the items `keep` accepts:
-    /// index, distance, normal, face normal. Of two hits at the same
-    /// distance the first item's is kept.
+    /// its index and the hit. Of two hits at the same distance the first
+    /// item's is kept.
     #[inline(always)]
     pub fn nearest<T: Intersect>(
         &self,
@@ -104,16 +130,16 @@ impl Accel {
         d: V3,
         t_max: f64,
         keep: impl Fn(usize) -> bool,
-    ) -> Option<(usize, f64, V3, V3)> {
+    ) -> Option<(usize, FaceHit)> {
         let mut best = None;
         let mut t_best = t_max;
         for (i, item) in items.iter().enumerate() {
             if !keep(i) {
                 continue;
             }
-            if let Some((t, n, ng)) = item.hit_face(o, d, t_best) {
-                t_best = t;
-                best = Some((i, t, n, ng));
+            if let Some(h) = item.hit_face(o, d, t_best) {
+                t_best = h.t;
+                best = Some((i, h));
             }
         }
         best
@@ -170,9 +196,9 @@ mod tests {
         let accel = Accel::new(&balls);
         let (o, d) = (V3::new(0.0, 0.0, 0.0), V3::new(0.0, 0.0, 1.0));
         let hit = accel.nearest(&balls, o, d, f64::INFINITY, |_| true);
-        assert_eq!(hit.map(|h| (h.0, h.1)), Some((1, 4.0)));
+        assert_eq!(hit.map(|h| (h.0, h.1.t)), Some((1, 4.0)));
         let hit = accel.nearest(&balls, o, d, f64::INFINITY, |i| i != 1);
-        assert_eq!(hit.map(|h| (h.0, h.1)), Some((0, 9.0)));
+        assert_eq!(hit.map(|h| (h.0, h.1.t)), Some((0, 9.0)));
         assert!(accel.nearest(&balls, o, d, 3.0, |_| true).is_none());
         assert!(accel.any(&balls, o, d, 4.5, |_| true));
         assert!(!accel.any(&balls, o, d, 4.5, |i| i != 1));

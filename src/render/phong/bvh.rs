@@ -8,9 +8,15 @@
 //!
 //! Items are addressed by their position in [`Bvh::order`]: the caller
 //! stores them in that order, so that a leaf's items are contiguous.
+//!
+//! The walk reads nodes of 32 bytes: boxes in f32, rounded outwards from
+//! the build's f64 ones, so that a box holds everything the exact one
+//! holds (a ray may enter a few more leaves, never fewer) in half the
+//! memory. The slab test itself is in f64.
 
 use super::accel::Aabb;
-use super::bvh_build::{self, Item, Node, SAH_DEPTH};
+use super::bvh_build::{self, Item, SAH_DEPTH};
+use super::bvh_node::Node32;
 use crate::math::V3;
 
 /// The walk's stack: deep enough for any tree the build makes
@@ -20,7 +26,7 @@ const STACK: usize = SAH_DEPTH + 66;
 /// The hierarchy; `order[k]` is the input index of the item at position k.
 #[derive(Clone, Debug)]
 pub struct Bvh {
-    nodes: Vec<Node>,
+    nodes: Vec<Node32>,
     pub order: Vec<u32>,
 }
 
@@ -44,7 +50,7 @@ impl Bvh {
             nodes[0].hi = [f64::NEG_INFINITY; 3];
         }
         Bvh {
-            nodes,
+            nodes: nodes.iter().map(Node32::of).collect(),
             order: items.iter().map(|it| it.index).collect(),
         }
     }
@@ -97,7 +103,7 @@ impl Bvh {
         let mut stack = vec![0usize];
         while let Some(i) = stack.pop() {
             let n = &self.nodes[i];
-            if !enter(&n.lo, &n.hi) {
+            if !enter(&n.lo.map(f64::from), &n.hi.map(f64::from)) {
                 continue;
             }
             if n.count > 0 {
@@ -115,31 +121,17 @@ impl Bvh {
 
     /// Visits the items of the leaves whose boxes the ray meets before the
     /// reach, nearer boxes first; `visit` gives the new reach, or `None`
-    /// to stop.
+    /// to stop. A box left behind is kept with the distance the ray enters
+    /// it at, and skipped without a second test once the reach has shrunk
+    /// below that.
     #[inline(always)]
     fn walk(&self, o: V3, d: V3, t_max: f64, mut visit: impl FnMut(usize) -> Option<f64>) {
-        let o = o.to_array();
-        let inv = [1.0 / d.x, 1.0 / d.y, 1.0 / d.z];
+        let ray = Slab::new(o, d);
         let mut reach = t_max;
-        let enter = |n: &Node, reach: f64| -> f64 {
-            let mut t0: f64 = 0.0;
-            let mut t1 = reach;
-            for a in 0..3 {
-                let ta = (n.lo[a] - o[a]) * inv[a];
-                let tb = (n.hi[a] - o[a]) * inv[a];
-                t0 = t0.max(ta.min(tb));
-                t1 = t1.min(ta.max(tb));
-            }
-            if t0 <= t1 {
-                t0
-            } else {
-                f64::INFINITY
-            }
-        };
-        let mut stack = [0u32; STACK];
+        let mut stack = [(0u32, 0f64); STACK];
         let mut top = 0;
         let mut node = 0usize;
-        if self.order.is_empty() || enter(&self.nodes[0], reach).is_infinite() {
+        if self.order.is_empty() || ray.enter(&self.nodes[0], reach).is_infinite() {
             return;
         }
         loop {
@@ -153,7 +145,10 @@ impl Bvh {
                 }
             } else {
                 let (l, r) = (n.first as usize, n.first as usize + 1);
-                let (tl, tr) = (enter(&self.nodes[l], reach), enter(&self.nodes[r], reach));
+                let (tl, tr) = (
+                    ray.enter(&self.nodes[l], reach),
+                    ray.enter(&self.nodes[r], reach),
+                );
                 let (near, far, tn, tf) = if tl <= tr {
                     (l, r, tl, tr)
                 } else {
@@ -162,25 +157,70 @@ impl Bvh {
                 if tn.is_finite() {
                     if tf.is_finite() {
                         // the build keeps the depth below STACK
-                        stack[top] = far as u32;
+                        stack[top] = (far as u32, tf);
                         top += 1;
                     }
                     node = near;
                     continue;
                 }
             }
-            // next: a farther child left behind, if still in reach
+            // next: a farther box left behind, if still in reach
             loop {
                 if top == 0 {
                     return;
                 }
                 top -= 1;
-                let k = stack[top] as usize;
-                if enter(&self.nodes[k], reach).is_finite() {
-                    node = k;
+                let (k, t) = stack[top];
+                if t <= reach {
+                    node = k as usize;
                     break;
                 }
             }
+        }
+    }
+}
+
+/// A ray as the slab test reads it: its origin and the inverse of its
+/// direction, and which of each axis' planes it meets first.
+struct Slab {
+    o: [f64; 3],
+    inv: [f64; 3],
+    neg: [bool; 3],
+}
+
+impl Slab {
+    #[inline(always)]
+    fn new(o: V3, d: V3) -> Slab {
+        let inv = [1.0 / d.x, 1.0 / d.y, 1.0 / d.z];
+        Slab {
+            o: o.to_array(),
+            inv,
+            neg: inv.map(|i| i < 0.0),
+        }
+    }
+
+    /// The distance the ray enters the box of `n` at (0 when it starts
+    /// inside), or infinity when it misses it within `reach`.
+    #[inline(always)]
+    fn enter(&self, n: &Node32, reach: f64) -> f64 {
+        let mut t0: f64 = 0.0;
+        let mut t1 = reach;
+        for a in 0..3 {
+            let (near, far) = if self.neg[a] {
+                (n.hi[a], n.lo[a])
+            } else {
+                (n.lo[a], n.hi[a])
+            };
+            let ta = (f64::from(near) - self.o[a]) * self.inv[a];
+            let tb = (f64::from(far) - self.o[a]) * self.inv[a];
+            // max/min keep a NaN (0 * inf, a ray in a box's plane) out
+            t0 = t0.max(ta);
+            t1 = t1.min(tb);
+        }
+        if t0 <= t1 {
+            t0
+        } else {
+            f64::INFINITY
         }
     }
 }
@@ -261,6 +301,15 @@ mod tests {
             .nodes
             .iter()
             .all(|n| n.count as usize <= bvh_build::MAX_LEAF));
+        // the f32 boxes hold the f64 ones: every item's box in its leaf's
+        for n in bvh.nodes.iter().filter(|n| n.count > 0) {
+            for k in n.first..n.first + n.count {
+                let b = &boxes[bvh.order[k as usize] as usize];
+                for a in 0..3 {
+                    assert!(f64::from(n.lo[a]) <= b.lo.get(a) && f64::from(n.hi[a]) >= b.hi.get(a));
+                }
+            }
+        }
         assert_eq!(bvh.order, Bvh::build(&boxes).order);
         assert!(Bvh::build(&[])
             .nearest(

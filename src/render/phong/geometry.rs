@@ -5,7 +5,8 @@
 //! against is the `Accel`'s business (`accel.rs`).
 
 pub use super::accel::Intersect;
-use super::accel::{Aabb, Accel};
+pub use super::accel::TriPoint;
+use super::accel::{Aabb, Accel, FaceHit};
 use super::camera::CameraRays;
 use super::trimesh::{self, Placed};
 use crate::math::V3;
@@ -83,13 +84,15 @@ impl Prim {
 
 /// A ray hit: distance along the ray, normal (unit, not yet turned
 /// towards the ray: on a mesh the shading one), the face's own normal
-/// (unit, the same but on a mesh) and the object hit.
+/// (unit, the same but on a mesh), the object hit and, on a mesh, the
+/// triangle and barycentrics where.
 #[derive(Clone, Copy, Debug)]
 pub struct Hit {
     pub t: f64,
     pub n: V3,
     pub face: V3,
     pub object: u32,
+    pub tri: Option<TriPoint>,
 }
 
 /// A primitive that may block light from a given point.
@@ -194,12 +197,13 @@ impl Geometry {
     /// The nearest hit within (EPS, t_max) among the primitives `tested` keeps.
     #[inline(always)]
     fn nearest(&self, o: V3, d: V3, t_max: f64, tested: impl Fn(usize) -> bool) -> Option<Hit> {
-        let (i, t, n, face) = self.accel.nearest(&self.prims, o, d, t_max, tested)?;
+        let (i, h) = self.accel.nearest(&self.prims, o, d, t_max, tested)?;
         Some(Hit {
-            t,
-            n,
-            face,
+            t: h.t,
+            n: h.n,
+            face: h.face,
             object: self.owner[i],
+            tri: h.tri,
         })
     }
 
@@ -454,15 +458,20 @@ impl Intersect for Prim {
                 let b = w.dot(u.cross(q));
                 ((0.0..=1.0).contains(&a) && (0.0..=1.0).contains(&b)).then_some((t, n))
             }
-            Prim::Mesh(ref m) => m.hit(o, d, t_max).map(|(t, n, _)| (t, n)),
+            Prim::Mesh(ref m) => m.hit(o, d, t_max).map(|h| (h.t, h.n)),
         }
     }
 
     #[inline]
-    fn hit_face(&self, o: V3, d: V3, t_max: f64) -> Option<(f64, V3, V3)> {
+    fn hit_face(&self, o: V3, d: V3, t_max: f64) -> Option<FaceHit> {
         match *self {
             Prim::Mesh(ref m) => m.hit(o, d, t_max),
-            _ => self.hit(o, d, t_max).map(|(t, n)| (t, n, n)),
+            _ => self.hit(o, d, t_max).map(|(t, n)| FaceHit {
+                t,
+                n,
+                face: n,
+                tri: None,
+            }),
         }
     }
 

@@ -5,7 +5,7 @@
 //! free; built per candidate when a free parameter moves geometry.
 
 use super::camera::CameraRays;
-use super::geometry::{Geometry, Hit, Intersect, Occluder, EPS};
+use super::geometry::{Geometry, Hit, Intersect, Occluder, TriPoint, EPS};
 use crate::math::V3;
 use crate::scene::field::{LightField, MaterialField};
 use crate::scene::{Field, LightKind, ParamSpace, Scene};
@@ -33,6 +33,8 @@ pub struct Vertex {
     pub n: V3,
     /// Unit direction back along the incoming ray.
     pub v: V3,
+    /// On a mesh: the triangle and barycentrics hit.
+    pub tri: Option<TriPoint>,
 }
 
 /// Shadowing of one vertex by one light.
@@ -257,6 +259,7 @@ impl Tracer<'_> {
             p,
             n,
             v: -d,
+            tri: hit.tri,
         });
         for l in 0..self.scene.lights.len() {
             let s = self.classify(p, n, face, hit.object, l);

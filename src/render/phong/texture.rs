@@ -9,11 +9,11 @@
 //! nothing here, so its render is unchanged.
 
 use super::effects::Lobes;
-use super::geometry::Prim;
 use super::packed::Packed;
 use super::paths::Paths;
 use crate::math::V3;
 use crate::render::RenderFailure;
+use crate::scene::mesh::{self, Mesh};
 use crate::scene::texture::{self, uv, MapKind, Texels, TextureRef};
 use crate::scene::transform::Affine;
 use crate::scene::{Object, Scene, Shape};
@@ -100,12 +100,26 @@ impl HitMaps {
             shininess_of: shin.iter().map(Option::is_some).collect(),
         };
         let frames: Vec<Option<Frame>> = scene.objects.iter().map(Frame::of).collect();
+        // each mesh looked up once, not per hit
+        let meshes: Vec<Option<Arc<Mesh>>> = scene
+            .objects
+            .iter()
+            .map(|o| match &o.shape {
+                Shape::Mesh { file } => mesh::get(std::path::Path::new(file)).ok(),
+                _ => None,
+            })
+            .collect();
         for (vi, vert) in paths.verts.iter().enumerate() {
             let o = vert.object as usize;
             if color[o].is_none() && spec[o].is_none() && shin[o].is_none() {
                 continue;
             }
-            let Some(uv) = hit_uv(paths, &scene.objects[o], frames[o].as_ref(), vert) else {
+            let Some(uv) = hit_uv(
+                &scene.objects[o],
+                frames[o].as_ref(),
+                meshes[o].as_deref(),
+                vert,
+            ) else {
                 continue;
             };
             let k = packed.packed_of[vi] as usize;
@@ -218,30 +232,18 @@ impl Frame {
 }
 
 /// The texture coordinates of a hit on `object`: a primitive's from the
-/// hit point in the object's frame; a mesh's from the triangle found again
-/// by a short ray back along the incoming one.
+/// hit point in the object's frame; a mesh's from the triangle and
+/// barycentrics the hit was found at.
 fn hit_uv(
-    paths: &Paths,
     object: &Object,
     frame: Option<&Frame>,
+    mesh: Option<&Mesh>,
     vert: &super::paths::Vertex,
 ) -> Option<[f64; 2]> {
-    let Shape::Mesh { file } = &object.shape else {
+    let Shape::Mesh { .. } = &object.shape else {
         let p = frame.map_or(vert.p, |f| f.point(vert.p));
         return uv::primitive_uv(&object.shape, p);
     };
-    let geo = &paths.geometry;
-    let placed = geo
-        .prims
-        .iter()
-        .zip(&geo.owner)
-        .find_map(|(p, &o)| match p {
-            Prim::Mesh(m) if o == vert.object => Some(m),
-            _ => None,
-        })?;
-    let p = vert.p;
-    let delta = 1e-5 * (1.0 + p.x.abs().max(p.y.abs()).max(p.z.abs()));
-    let (tri, b1, b2) = placed.locate(p + vert.v * delta, -vert.v, 2.0 * delta)?;
-    let mesh = crate::scene::mesh::get(std::path::Path::new(file)).ok()?;
-    uv::mesh_uv(&mesh, tri, b1, b2)
+    let at = vert.tri?;
+    uv::mesh_uv(mesh?, at.tri as usize, at.u, at.v)
 }

@@ -4,8 +4,9 @@
 //! carries rays into that frame and normals out of it — so that a free
 //! pose costs no rebuild.
 
-use super::accel::{Aabb, EPS};
+use super::accel::{Aabb, FaceHit, TriPoint, EPS};
 use super::bvh::Bvh;
+use super::inner_ball::{self, Ball};
 use crate::math::V3;
 use crate::scene::mesh::{self, Mesh};
 use crate::scene::transform::Affine;
@@ -55,6 +56,8 @@ pub struct TriMesh {
     pub bounds: Aabb,
     /// A sphere holding every vertex: centre and radius.
     sphere: (V3, f64),
+    /// For a closed mesh, a ball inside it (`inner_ball.rs`).
+    ball: Option<Ball>,
 }
 
 impl TriMesh {
@@ -94,7 +97,7 @@ impl TriMesh {
             .iter()
             .map(|&v| (V3::from(v) - centre).length())
             .fold(0.0, f64::max);
-        TriMesh {
+        let mut t = TriMesh {
             tris,
             normals,
             bvh,
@@ -103,7 +106,31 @@ impl TriMesh {
                 hi: V3::from(hi),
             },
             sphere: (centre, radius),
-        }
+            ball: None,
+        };
+        let bounds = (t.bounds.lo, t.bounds.hi);
+        t.ball = inner_ball::find(&m.positions, &m.triangles, bounds, |o, d| t.crossings(o, d));
+        t
+    }
+
+    /// The number of triangles the ray o + t d meets (t > EPS).
+    fn crossings(&self, o: V3, d: V3) -> usize {
+        let mut n = 0;
+        self.bvh.any(o, d, f64::INFINITY, |k| {
+            n += self.tris[k].hit(o, d, f64::INFINITY).is_some() as usize;
+            false
+        });
+        n
+    }
+
+    /// True when the ray starts outside the bounding sphere by more than
+    /// rounding error and EPS along it: it is then outside the mesh, and
+    /// any crossing of the surface lies at t > EPS.
+    #[inline]
+    fn starts_outside(&self, o: V3, d: V3) -> bool {
+        let (c, r) = self.sphere;
+        let margin = 2.0 * EPS * d.length() + 1e-9 * (1.0 + r + c.length());
+        (o - c).length() > r + margin
     }
 
     /// True when some vertex x has x . m > thr: the mesh reaches above
@@ -129,9 +156,10 @@ impl TriMesh {
     /// The nearest hit: distance, the shading normal (not unit): the
     /// vertex normals interpolated, or the face normal, on the side of the
     /// face the ray meets, so that the tracer's front and back agree with
-    /// the geometry; and the face normal (not unit).
+    /// the geometry; the face normal (not unit); and the triangle and
+    /// barycentrics the walk found it at (what a texture is looked up by).
     #[inline]
-    pub fn hit(&self, o: V3, d: V3, t_max: f64) -> Option<(f64, V3, V3)> {
+    pub fn hit(&self, o: V3, d: V3, t_max: f64) -> Option<(f64, V3, V3, TriPoint)> {
         let mut uv = (0.0, 0.0);
         let (k, t) = self.bvh.nearest(o, d, t_max, |k, tb| {
             let (t, u, v) = self.tris[k].hit(o, d, tb)?;
@@ -139,35 +167,35 @@ impl TriMesh {
             Some(t)
         })?;
         // uv is the last accepted hit's, which is the nearest
+        let (u, v) = uv;
+        let at = TriPoint {
+            tri: self.bvh.order[k],
+            u,
+            v,
+        };
         let tri = &self.tris[k];
         let ng = tri.e1.cross(tri.e2);
         let Some(n) = self.normals.get(k) else {
-            return Some((t, ng, ng));
+            return Some((t, ng, ng, at));
         };
-        let (u, v) = uv;
         let ns = n[0] * (1.0 - u - v) + n[1] * u + n[2] * v;
         let ns = if ns.dot(ng) < 0.0 { -ns } else { ns };
         // a shading normal turned past the ray (or zero) would flip the
         // side the tracer shades: keep the face's there
         let same_side = (ns.dot(d) < 0.0) == (ng.dot(d) < 0.0) && ns.dot(ns) > 0.0;
-        Some((t, if same_side { ns } else { ng }, ng))
+        Some((t, if same_side { ns } else { ng }, ng, at))
     }
 
-    /// The nearest hit's triangle, numbered as in the file, and its
-    /// barycentric (u, v): where a texture is looked up (`texture.rs`).
-    pub fn locate(&self, o: V3, d: V3, t_max: f64) -> Option<(usize, f64, f64)> {
-        let mut uv = (0.0, 0.0);
-        let (k, _) = self.bvh.nearest(o, d, t_max, |k, tb| {
-            let (t, u, v) = self.tris[k].hit(o, d, tb)?;
-            uv = (u, v);
-            Some(t)
-        })?;
-        Some((self.bvh.order[k] as usize, uv.0, uv.1))
-    }
-
-    /// True when any triangle is hit within (EPS, t_max).
+    /// True when any triangle is hit within (EPS, t_max). A ray from
+    /// outside that reaches the inner ball crosses the surface before it
+    /// (`inner_ball.rs`): blocked without a walk.
     #[inline]
     pub fn any(&self, o: V3, d: V3, t_max: f64) -> bool {
+        if let Some(ball) = &self.ball {
+            if inner_ball::reaches(ball, o, d, t_max) && self.starts_outside(o, d) {
+                return true;
+            }
+        }
         self.bvh
             .any(o, d, t_max, |k| self.tris[k].hit(o, d, t_max).is_some())
     }
@@ -273,16 +301,22 @@ impl Placed {
         }
     }
 
-    /// Distance, unit shading normal and unit face normal of the nearest hit.
+    /// The nearest hit: distance, unit shading normal, unit face normal
+    /// and where on the mesh.
     #[inline]
-    pub fn hit(&self, o: V3, d: V3, t_max: f64) -> Option<(f64, V3, V3)> {
+    pub fn hit(&self, o: V3, d: V3, t_max: f64) -> Option<FaceHit> {
         let (ol, dl) = self.local(o, d)?;
-        let (t, n, ng) = self.mesh.hit(ol, dl, t_max)?;
+        let (t, n, ng, at) = self.mesh.hit(ol, dl, t_max)?;
         let (n, ng) = match &self.place {
             Place::Moved(m) => (m.0.normal(n), m.0.normal(ng)),
             _ => (n, ng),
         };
-        Some((t, n.normalized(), ng.normalized()))
+        Some(FaceHit {
+            t,
+            n: n.normalized(),
+            face: ng.normalized(),
+            tri: Some(at),
+        })
     }
 
     /// A sphere holding the placed mesh: centre and radius. The transform
@@ -319,15 +353,69 @@ impl Placed {
         }
     }
 
-    /// [`TriMesh::locate`] for a world ray.
-    pub fn locate(&self, o: V3, d: V3, t_max: f64) -> Option<(usize, f64, f64)> {
-        let (ol, dl) = self.local(o, d)?;
-        self.mesh.locate(ol, dl, t_max)
-    }
-
     #[inline]
     pub fn any(&self, o: V3, d: V3, t_max: f64) -> bool {
         self.local(o, d)
             .is_some_and(|(ol, dl)| self.mesh.any(ol, dl, t_max))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A closed box of twelve triangles, stretched, as a mesh.
+    fn cube() -> Mesh {
+        let positions = (0..8)
+            .map(|k| {
+                [0, 1, 2].map(|a| (if k >> a & 1 == 0 { -1.0 } else { 1.0 }) * [1.0, 0.6, 0.3][a])
+            })
+            .collect();
+        let mut triangles = Vec::new();
+        for f in [
+            [0, 1, 3, 2],
+            [4, 6, 7, 5],
+            [0, 4, 5, 1],
+            [2, 3, 7, 6],
+            [0, 2, 6, 4],
+            [1, 5, 7, 3],
+        ] {
+            triangles.push([f[0], f[1], f[2]]);
+            triangles.push([f[0], f[2], f[3]]);
+        }
+        Mesh {
+            positions,
+            normals: Vec::new(),
+            texcoords: Vec::new(),
+            triangles,
+        }
+    }
+
+    /// The inner ball's shortcut answers every shadow ray as the walk
+    /// does: from points outside, inside and on the box, towards ends
+    /// inside, outside and beyond it; and it does answer many of them.
+    #[test]
+    fn the_inner_ball_blocks_exactly_what_the_walk_blocks() {
+        let t = TriMesh::new(&cube());
+        let ball = t.ball.expect("a closed box holds a ball");
+        assert!(ball.r > 0.29 && ball.r < 0.3, "{ball:?}");
+        let walk = |o: V3, d: V3, t_max: f64| {
+            t.bvh
+                .any(o, d, t_max, |k| t.tris[k].hit(o, d, t_max).is_some())
+        };
+        let mut short = 0;
+        for i in 0..2000 {
+            let f = i as f64;
+            let s = 0.3 + 2.0 * ((f * 0.37).sin() * 0.5 + 0.5);
+            let o = V3::new((f * 1.3).sin(), (f * 0.7).cos(), (f * 0.11).sin()) * s;
+            let to = V3::new((f * 0.53).cos(), (f * 0.91).sin(), (f * 0.29).cos()) * 0.4;
+            let d = (to - o).normalized();
+            for t_max in [0.2, (to - o).length(), 1e9] {
+                let shortcut = inner_ball::reaches(&ball, o, d, t_max) && t.starts_outside(o, d);
+                short += shortcut as usize;
+                assert_eq!(t.any(o, d, t_max), walk(o, d, t_max), "ray {i} {t_max}");
+            }
+        }
+        assert!(short > 500, "{short}");
     }
 }
