@@ -2,21 +2,26 @@
 //! the model lacks, add it, refit, and report the error before and after
 //! (docs/diagnose.md).
 //!
-//! Each round scores every applicable effect (`effects/`) by how much of
-//! the residual its feature maps explain (`residual.rs`), then confirms
-//! each by refits with the effect added (`refit.rs`): a warm one (from the
-//! best of the effect's starts, `starts.rs`, its own parameters and those
-//! it trades with searched, then everything refined around the result) and
-//! one from scratch (every parameter over its bounds), the better
-//! counting. An effect is accepted when its refit lowers the Bayesian
-//! information criterion by more than a margin and the sum of absolute
-//! differences by at least `min_gain` (`selection.rs`), against the
-//! unchanged model refitted the same two ways, so that neither further
-//! convergence nor a better basin is credited to an effect. An accepted
-//! model is polished (every parameter refined) before the next round.
-//! Rounds repeat until nothing is accepted; `unexplained` is reported when
-//! smooth structure remains in the residual. Inputs come from a fit
-//! directory (`inputs.rs`); the files written are named in `rundir`.
+//! One photograph is a set of one (`SetInputs::one`): it takes the same
+//! path as a set (`diagnose` here, `rounds.rs`), only its refits differ
+//! (`Schedule`, `schedule.rs`, dispatched in `trials.rs`). Each round
+//! scores every applicable effect (`effects/`) by how much of the residual
+//! its feature maps explain (`residual.rs`, pooled over the photographs),
+//! then confirms each by refits with the effect added: for one
+//! photograph a warm one (from the best of the effect's starts,
+//! `starts.rs`, its own parameters and those it trades with searched, then
+//! everything refined around the result) and one from scratch (every
+//! parameter over its bounds), the better counting (`one_refit.rs`); for
+//! a set a warm set fit (`set_refit.rs`). An effect is accepted when its
+//! refit lowers the Bayesian information criterion by more than a margin
+//! and the sum of absolute differences by at least `min_gain`
+//! (`selection.rs`), against the unchanged model refitted the same ways,
+//! so that neither further convergence nor a better basin is credited to
+//! an effect. An accepted model is settled (polished, or for a set
+//! refitted from scratch) before the next round. Rounds repeat until
+//! nothing is accepted; `unexplained` is reported when smooth structure
+//! remains in the residual. Inputs come from a fit directory
+//! (`inputs.rs`); the files written are named in `rundir`.
 
 mod albedo;
 mod backward;
