@@ -17,15 +17,13 @@
 //! values solved, ln N each.
 
 use super::inputs::Params;
-use super::refit::{Model, Refine, Refits};
-use super::set_refit::{shots_of, SetModel, SetRefits};
-use super::Candidate;
+use super::model::{shots_of, Model};
+use super::refits::Refits;
 use crate::error::{Error, Result};
 use crate::fit::set::shots::Shot;
 use crate::metric::Mask;
 use crate::raster::Image;
 use crate::render::camera_effects;
-use crate::render::render_one;
 use crate::scene::albedo_map::{self, AlbedoMap};
 use crate::scene::{Response, Scene};
 use std::path::{Path, PathBuf};
@@ -258,72 +256,10 @@ pub fn prune(out: &Path, kept: &Scene) {
     }
 }
 
-/// One photograph: the map solved for `scene`, written to `path`; None
-/// when no value could be solved.
-fn solve_one(
+/// The map solved for `scene` with each photograph's `own` values,
+/// written to `path`; None when no value could be solved.
+fn solve_for(
     fits: &mut Refits,
-    scene: &Scene,
-    path: &Path,
-    out: &Path,
-) -> Result<Option<(Scene, usize)>> {
-    let zero = zero_map(scene, out)?;
-    let (lit, dark) = probes(scene, &zero);
-    let renderer = fits.renderer();
-    fits.renders += 2;
-    let evidence = [Evidence {
-        target: &fits.inputs.target,
-        mask: fits.inputs.mask.as_ref(),
-        lit: render_one(renderer, &lit, 0)?,
-        dark: render_one(renderer, &dark, 0)?,
-    }];
-    discard(&zero);
-    let solved = solve(&evidence, scene.camera.response);
-    if solved.count == 0 {
-        return Ok(None);
-    }
-    albedo_map::write(path, solved.map)?;
-    Ok(Some((with_map(scene, Some(path)), solved.count)))
-}
-
-/// The candidate `albedo_map` (named `effect`) on one photograph: solved,
-/// the others refitted, solved again; None when nothing could be solved.
-pub fn candidate(
-    effect: &str,
-    fits: &mut Refits,
-    model: &Model,
-    round: usize,
-    out: &Path,
-) -> Result<Option<(Candidate, Model)>> {
-    let (first, second) = (map_path(out, round, true), map_path(out, round, false));
-    let Some((scene, count1)) = solve_one(fits, &model.scene, &first, out)? else {
-        return Ok(None);
-    };
-    let config = fits.config;
-    let refit = fits.run(
-        &scene,
-        None,
-        Refine::close(config, config.refine_generations),
-    )?;
-    // The losing map stays on disk until the diagnosis prunes every map
-    // its final model does not name (`prune`).
-    let (mut fitted, mut count) = (refit, count1);
-    if let Some((again, count2)) = solve_one(fits, &fitted.scene, &second, out)? {
-        fits.renders += 1;
-        let image = render_one(fits.renderer(), &again, 0)?;
-        let m = Model::new(again, image, fits.inputs);
-        if m.sad < fitted.sad {
-            (fitted, count) = (m, count2);
-        }
-    }
-    let refit = "closed form, then warm";
-    let c = Candidate::scored(effect, round, fits.inputs, model, &fitted, count, refit);
-    Ok(Some((c, fitted)))
-}
-
-/// A set: the map solved for `scene` with each photograph's `own`
-/// values, written to `path`; None when no value could be solved.
-fn solve_set(
-    fits: &mut SetRefits,
     scene: &Scene,
     own: &[Params],
     path: &Path,
@@ -331,11 +267,11 @@ fn solve_set(
     let zero = zero_map(scene, fits.out)?;
     let (lit, dark) = probes(scene, &zero);
     let inputs = fits.inputs;
-    let rendered = |fits: &mut SetRefits, s: &Scene| -> Result<Vec<Image>> {
+    let rendered = |fits: &mut Refits, s: &Scene| -> Result<Vec<Image>> {
         let shots: Vec<Shot> = shots_of(s, inputs, own)?;
         fits.render(&shots)?
             .map(|(images, _)| images)
-            .ok_or_else(|| Error::Run("albedo_map: a render of the set failed".into()))
+            .ok_or_else(|| Error::Run("albedo_map: a render of the photographs failed".into()))
     };
     let lit = rendered(fits, &lit)?;
     let dark = rendered(fits, &dark)?;
@@ -359,33 +295,27 @@ fn solve_set(
     Ok(Some((with_map(scene, Some(path)), solved.count)))
 }
 
-/// The model of a set with `albedo_map`: solved, the others refitted over
-/// the set, solved again; the model and the values solved (None: nothing
-/// could be solved).
-pub fn set_model(
-    fits: &mut SetRefits,
-    model: &SetModel,
+/// The model with `albedo_map`: solved, the others refitted
+/// (`Refits::after_solve`), solved again, the better of the two kept; the
+/// model and the values solved (None: nothing could be solved).
+pub(super) fn solved(
+    fits: &mut Refits,
+    model: &Model,
     round: usize,
-) -> Result<Option<(SetModel, usize)>> {
+) -> Result<Option<(Model, usize)>> {
     let out = fits.out;
     let (first, second) = (map_path(out, round, true), map_path(out, round, false));
-    let Some((scene, count1)) = solve_set(fits, &model.scene, &model.own, &first)? else {
+    let Some((scene, count1)) = solve_for(fits, &model.scene, &model.own, &first)? else {
         return Ok(None);
     };
-    // As for one photograph, the losing map is left to `prune`.
-    let (mut fitted, mut count) = (fits.run(&scene, &model.own)?, count1);
-    if let Some((again, count2)) = solve_set(fits, &fitted.scene, &fitted.own, &second)? {
-        let shots = shots_of(&again, fits.inputs, &fitted.own)?;
-        if let Some((images, sad)) = fits.render(&shots)? {
-            if sad < fitted.sad {
-                let own = fitted.own.clone();
-                fitted = SetModel {
-                    scene: again,
-                    own,
-                    images,
-                    sad,
-                };
-                count = count2;
+    // The losing map stays on disk until the diagnosis prunes every map
+    // its final model does not name (`prune`).
+    let (mut fitted, mut count) = (fits.after_solve(&scene, &model.own)?, count1);
+    if let Some((again, count2)) = solve_for(fits, &fitted.scene, &fitted.own, &second)? {
+        let own = fitted.own.clone();
+        if let Some(m) = fits.model_of(again, &own)? {
+            if m.sad < fitted.sad {
+                (fitted, count) = (m, count2);
             }
         }
     }

@@ -1,5 +1,5 @@
-//! The backward step of the diagnosis's model selection, shared by the
-//! rounds of one photograph (`mod.rs`) and of a set (`set.rs`): after each
+//! The backward step of the diagnosis's model selection, run by the
+//! rounds (`rounds.rs`) of one photograph and of a set alike: after each
 //! acceptance every earlier accepted effect is tested for removal (the
 //! model rebuilt without it and refitted), and the one that pays least is
 //! dropped when the criterion no longer accepts it over the model without

@@ -76,6 +76,23 @@ pub struct SetInputs {
 }
 
 impl SetInputs {
+    /// One photograph as a set of one: its scene shared, the photograph
+    /// its one shot, with no own values.
+    pub fn one(inputs: &Inputs) -> SetInputs {
+        let target = FitTarget {
+            image: inputs.target.clone(),
+            levels: None,
+            mask: inputs.mask.clone(),
+            path: None,
+            encoding: None,
+        };
+        SetInputs {
+            scene: inputs.scene.clone(),
+            shots: vec![Shot::one(&inputs.scene, target)],
+            own: vec![Params::new()],
+        }
+    }
+
     /// The set fit in `dir`, or None when `dir` holds a fit of one photograph.
     pub fn from_fit_dir(dir: &Path) -> Result<Option<SetInputs>> {
         if !dir.join(crate::rundir::RESULT).is_file() {

@@ -6,8 +6,8 @@
 
 use super::diagnosis::{Diagnosis, SetDiagnosis};
 use super::inputs::SetInputs;
+use super::model::Model;
 use super::residual::Residual;
-use super::set_refit::SetModel;
 use crate::error::{Error, Result};
 use crate::fsio::write_atomic;
 use crate::metric::Deviation;
@@ -46,7 +46,7 @@ pub fn write(
 pub fn write_set(
     out: &Path,
     d: &SetDiagnosis,
-    model: &SetModel,
+    model: &Model,
     inputs: &SetInputs,
     residuals: (&[Residual], &[Residual]),
 ) -> Result<()> {
