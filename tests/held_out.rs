@@ -195,3 +195,64 @@ fn hold_out_names_that_are_wrong_or_every_shot_exit_2_in_one_line() {
         assert!(!out.join("result.json").exists());
     }
 }
+
+#[test]
+fn a_set_diagnosis_predicts_the_held_out_photographs_before_and_after() {
+    let dir = tempfile::tempdir().unwrap();
+    let c = effects_data::case("none", 0, 1.0, 3, 0.0);
+    write_set(dir.path(), &c.truth, &c.model);
+    fit(dir.path(), "fit", &[]);
+    let fit_dir = dir.path().join("fit");
+    let diagnose = |out: &str, extra: &[&str]| {
+        let out = dir.path().join(out);
+        let mut args = vec![
+            "diagnose",
+            fit_dir.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+            "--population",
+            "4",
+            "--generations",
+            "4",
+            "--restart-generations",
+            "0",
+            "--max-effects",
+            "1",
+        ];
+        args.extend(extra);
+        (scenefit(&args), out)
+    };
+    let (o, out) = diagnose("diag", &["--hold-out", "s0"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let d = read_json(&out.join("diagnosis.json"));
+    let after: Vec<&str> = d["shots_after"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|s| s["name"].as_str().unwrap())
+        .collect();
+    assert_eq!(after, ["s1", "s2", "s3"], "held out of every refit");
+    let held: Vec<&str> = d["held_out"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|s| s["name"].as_str().unwrap())
+        .collect();
+    assert_eq!(held, ["s0", "s4"], "the diagnosis's and the fit's");
+    for h in d["held_out"].as_array().unwrap() {
+        for key in ["deviation_fit", "deviation_after"] {
+            let v = h[key]["average"].as_f64().unwrap();
+            assert!(v > 0.0 && v < 2.0, "{key} {v}");
+        }
+    }
+    let page = std::fs::read_to_string(out.join("report.html")).unwrap();
+    assert!(page.contains("s4 (held out)"), "the report marks it");
+    assert!(out.join("render_after_s4.png").is_file());
+    assert!(out.join("residual_after_s4.png").is_file());
+
+    let (o, _) = diagnose("diag2", &["--hold-out", "nope"]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+    assert!(err.contains("--hold-out") && err.contains("nope"), "{err}");
+}

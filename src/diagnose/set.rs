@@ -101,9 +101,12 @@ pub fn run(inputs: &SetInputs, out: &Path, config: &DiagnoseConfig) -> Result<Se
         removed,
         imitations,
     };
+    let (held_out, held_out_images) = predictions(inputs, &model, renderer.as_ref(), config)?;
     let d = SetDiagnosis {
         diagnosis,
         shots_after: shots_after(inputs, &model, &before, &after),
+        held_out,
+        held_out_images,
     };
     super::albedo::prune(out, &model.scene);
     super::report::write_set(
@@ -114,6 +117,21 @@ pub fn run(inputs: &SetInputs, out: &Path, config: &DiagnoseConfig) -> Result<Se
         (&residuals_before, &residuals_after),
     )?;
     Ok(d)
+}
+
+/// Each held-out photograph predicted by the fit's model and by `model`.
+fn predictions(
+    inputs: &SetInputs,
+    model: &SetModel,
+    renderer: &dyn crate::render::Renderer,
+    c: &DiagnoseConfig,
+) -> Result<(
+    Vec<crate::fit::set::held_out::Compared>,
+    Vec<crate::raster::Image>,
+)> {
+    use crate::fit::set::held_out::{compare, search};
+    let models = (&inputs.scene, &model.scene);
+    compare(models, &inputs.held_out, renderer, search(c.seed, c.jobs))
 }
 
 /// Every photograph's own values after, and its deviations.

@@ -16,6 +16,7 @@ use crate::fit::output::HeldOutResult;
 use crate::fit::search_run::halt_error;
 use crate::fit::FitConfig;
 use crate::metric::{deviation, Deviation};
+use crate::optimize::{DeConfig, Strategy};
 use crate::raster::Image;
 use crate::render::Renderer;
 use crate::rundir::RunDir;
@@ -151,18 +152,32 @@ pub struct Compared {
     pub deviation_after: Deviation,
 }
 
-/// Each of `held_out` predicted from the fit's model `fitted` and from the
-/// improved model `after`, with the same search (`config`): the entries
-/// and the predictions after.
+/// The search of a prediction outside a fit (a diagnosis): the hybrid
+/// strategy with its default budget, from `seed`, `jobs` renders at once.
+pub fn search(seed: u64, jobs: usize) -> FitConfig {
+    FitConfig {
+        de: DeConfig {
+            seed,
+            strategy: Strategy::Hybrid,
+            ..DeConfig::default()
+        },
+        jobs,
+        snapshot_every: usize::MAX / 2,
+        ..FitConfig::default()
+    }
+}
+
+/// Each of `held_out` predicted from the fit's model and from the
+/// improved model (`models`), with the same search (`config`): the
+/// entries, and the predictions after.
 pub fn compare(
-    fitted: &Scene,
-    after: &Scene,
+    (fitted, after): (&Scene, &Scene),
     held_out: &[Shot],
     renderer: &dyn Renderer,
-    config: &FitConfig,
-) -> Result<Vec<(Compared, Image)>> {
-    let before = predict(fitted, held_out, renderer, config, None)?;
-    let now = predict(after, held_out, renderer, config, None)?;
+    config: FitConfig,
+) -> Result<(Vec<Compared>, Vec<Image>)> {
+    let before = predict(fitted, held_out, renderer, &config, None)?;
+    let now = predict(after, held_out, renderer, &config, None)?;
     Ok(before
         .into_iter()
         .zip(now)
@@ -175,5 +190,5 @@ pub fn compare(
             };
             (c, a.image)
         })
-        .collect())
+        .unzip())
 }
