@@ -256,3 +256,32 @@ fn a_set_diagnosis_predicts_the_held_out_photographs_before_and_after() {
     assert_eq!(err.trim_end().lines().count(), 1, "{err}");
     assert!(err.contains("--hold-out") && err.contains("nope"), "{err}");
 }
+
+#[test]
+fn a_resume_holding_out_other_photographs_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let c = effects_data::case("none", 0, 1.0, 3, 0.0);
+    write_set(dir.path(), &c.truth, &c.model);
+    let r = fit(dir.path(), "fit", &[]);
+    // The same inputs resume (a finished run writes its result again).
+    let again = fit(dir.path(), "fit", &["--resume"]);
+    assert_eq!(again["held_out"], r["held_out"]);
+    let (model, shots) = (dir.path().join("model.json"), dir.path().join("shots.json"));
+    let out = dir.path().join("fit");
+    let o = scenefit(&[
+        "fit",
+        model.to_str().unwrap(),
+        "--shots",
+        shots.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--resume",
+        "--hold-out",
+        "s3",
+        "--quiet",
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+    assert!(err.contains("held out were [s4], now [s3, s4]"), "{err}");
+}
