@@ -100,6 +100,7 @@ fn a_set_of_two_photographs_goes_through_the_same_entry_point() {
                     mask: None,
                     encoding: None,
                     set: Default::default(),
+                    hold_out: false,
                 },
             }
         })

@@ -150,6 +150,22 @@ const INPUTS: &[Input] = &[
         output: "out",
     },
     Input {
+        label: "fit --shots --hold-out",
+        args: &[
+            "fit",
+            "s.json",
+            "--shots",
+            "shots.json",
+            "-o",
+            "out",
+            "--hold-out",
+            "b",
+        ],
+        file: "p2.png",
+        kind: Kind::Image,
+        output: "out",
+    },
+    Input {
         label: "fit --shots --resume",
         args: &[
             "fit",

@@ -23,6 +23,9 @@ pub struct DiagnoseRequest {
     pub mask: Option<PathBuf>,
     /// Replace an earlier diagnosis in `output`.
     pub overwrite: bool,
+    /// A set's shots held out of the diagnosis besides those the fit held
+    /// out (names as in its shots file).
+    pub hold_out: Vec<String>,
     pub config: DiagnoseConfig,
 }
 
@@ -35,7 +38,12 @@ enum Fitted {
 /// Diagnoses the fit in `r.fit_dir` into `r.output`; a set's diagnosis is
 /// returned as its pooled part.
 pub fn diagnose(r: &DiagnoseRequest) -> Result<Diagnosis> {
-    let set = SetInputs::from_fit_dir(&r.fit_dir)?;
+    let set = SetInputs::from_fit_dir(&r.fit_dir, &r.hold_out)?;
+    if set.is_none() && !r.hold_out.is_empty() {
+        return Err(Error::Usage(
+            "--hold-out: applies to a set of photographs; the fit directory holds one".into(),
+        ));
+    }
     if set.is_some() && (r.target.is_some() || r.mask.is_some()) {
         return Err(Error::Usage(format!(
             "--target/--mask: the fit directory holds a set of photographs; each one's target and mask come from its {SHOTS}"
@@ -89,7 +97,7 @@ fn refuse_inputs(out: &RunDir, r: &DiagnoseRequest, set: Option<&SetInputs>) -> 
         .into_iter()
         .filter_map(|(what, p)| p.as_deref().map(|p| (what.to_string(), p)))
         .collect();
-    for s in set.iter().flat_map(|s| &s.shots) {
+    for s in set.iter().flat_map(|s| s.shots.iter().chain(&s.held_out)) {
         inputs.push((format!("shot {}'s target", s.name), &s.entry.target));
         if let Some(m) = &s.entry.mask {
             inputs.push((format!("shot {}'s mask", s.name), m));

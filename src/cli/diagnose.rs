@@ -47,6 +47,11 @@ pub struct DiagnoseArgs {
     /// fit put them, which saves re-tracing every camera ray.
     #[arg(long)]
     refit_geometry: bool,
+    /// A set of photographs: leave these shots (names as in the fit's
+    /// shots file) out of the diagnosis too, and predict them before and
+    /// after (diagnosis.json's held_out); the fit's held-out ones always are.
+    #[arg(long, value_delimiter = ',', value_name = "NAME,...")]
+    hold_out: Vec<String>,
     /// Renders at once (default: the number of cores).
     #[arg(long, value_parser = super::numbers::positive_count, allow_hyphen_values = true)]
     jobs: Option<usize>,
@@ -98,6 +103,7 @@ pub fn run(a: DiagnoseArgs) -> Result<()> {
         target: a.target,
         mask: a.mask,
         overwrite: a.overwrite,
+        hold_out: a.hold_out,
         config,
     })?;
     println!(

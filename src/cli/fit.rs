@@ -118,14 +118,23 @@ pub struct FitArgs {
     /// block over the shared and every photograph's own values at once.
     #[arg(long)]
     joint: bool,
+    /// A set of photographs (--shots): leave these shots (names as in the
+    /// shots file) out of the fit and predict them from the fitted model
+    /// (result.json's held_out), besides those the file marks "hold_out".
+    #[arg(long, value_delimiter = ',', value_name = "NAME,...")]
+    hold_out: Vec<String>,
     /// No progress output.
     #[arg(long, short)]
     quiet: bool,
 }
 
 pub fn run(a: FitArgs) -> Result<()> {
-    if a.inputs.shots.is_none() && (a.joint || a.rounds.is_some()) {
-        let flag = if a.joint { "--joint" } else { "--rounds" };
+    let set_only = [
+        ("--joint", a.joint),
+        ("--rounds", a.rounds.is_some()),
+        ("--hold-out", !a.hold_out.is_empty()),
+    ];
+    if let (None, Some((flag, _))) = (&a.inputs.shots, set_only.iter().find(|f| f.1)) {
         return Err(Error::Usage(format!(
             "{flag}: applies to a set of photographs; give --shots SHOTS.json"
         )));
@@ -153,13 +162,15 @@ pub fn run(a: FitArgs) -> Result<()> {
     // Before any photograph is decoded: an image too large for this
     // machine is refused at once, not after seconds of decoding.
     api::check_memory(&request, 1)?;
-    let (photos, note) = a.inputs.photographs(&scene)?;
+    let (mut photos, note) = a.inputs.photographs(&scene)?;
+    crate::fit::set::held_out::mark(&mut photos.shots, &a.hold_out, "--hold-out")?;
     let mut progress = Progress::new(a.quiet);
     let fitted = api::fit(request, &photos, &a.output, &mut progress)?;
     progress.finish();
     tell(note.as_deref(), a.quiet);
     if !a.quiet {
-        println!("{}", summary(&fitted, photos.shots.len(), &a.output));
+        let fitted_shots = photos.shots.iter().filter(|s| !s.entry.hold_out);
+        println!("{}", summary(&fitted, fitted_shots.count(), &a.output));
     }
     Ok(())
 }
@@ -175,8 +186,9 @@ fn summary(fitted: &Fitted, photographs: usize, dir: &Path) -> String {
             d.r, d.g, d.b, d.average
         ),
         Some(worst) => format!(
-            "{photographs} photographs: average deviation {:.3} (worst photograph {worst:.3})",
-            d.average
+            "{photographs} photographs: average deviation {:.3} (worst photograph {worst:.3}){}",
+            d.average,
+            held_out(r)
         ),
     };
     format!(
@@ -185,6 +197,20 @@ fn summary(fitted: &Fitted, photographs: usize, dir: &Path) -> String {
         r.wall_seconds,
         r.stop_reason,
         dir.display()
+    )
+}
+
+/// The held-out photographs' predictions, as the summary says them.
+fn held_out(r: &crate::fit::FitResult) -> String {
+    let devs: Vec<f64> = r.held_out.iter().map(|h| h.deviation_fit.average).collect();
+    if devs.is_empty() {
+        return String::new();
+    }
+    let worst = devs.iter().copied().fold(0.0, f64::max);
+    let mean = devs.iter().sum::<f64>() / devs.len() as f64;
+    format!(
+        "; {} held out, predicted at {mean:.3} on average (worst {worst:.3})",
+        devs.len()
     )
 }
 

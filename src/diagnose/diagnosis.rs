@@ -71,6 +71,12 @@ pub struct SetDiagnosis {
     #[serde(flatten)]
     pub diagnosis: Diagnosis,
     pub shots_after: Vec<ShotAfter>,
+    /// Each held-out photograph predicted by the fit's model and the
+    /// improved one (`fit::set::held_out`), and the predictions after.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub held_out: Vec<crate::fit::set::held_out::Compared>,
+    #[serde(skip)]
+    pub held_out_images: Vec<crate::raster::Image>,
 }
 
 /// An accepted effect the backward step removed (diagnosis.json's

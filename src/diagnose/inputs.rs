@@ -73,6 +73,9 @@ pub struct SetInputs {
     pub shots: Vec<Shot>,
     /// Each photograph's own fitted values.
     pub own: Vec<Params>,
+    /// Photographs held out (by the fit or `diagnose --hold-out`): in no
+    /// refit, predicted at the end (`fit::set::held_out`).
+    pub held_out: Vec<Shot>,
 }
 
 impl SetInputs {
@@ -90,11 +93,13 @@ impl SetInputs {
             scene: inputs.scene.clone(),
             shots: vec![Shot::one(&inputs.scene, target)],
             own: vec![Params::new()],
+            held_out: Vec::new(),
         }
     }
 
-    /// The set fit in `dir`, or None when `dir` holds a fit of one photograph.
-    pub fn from_fit_dir(dir: &Path) -> Result<Option<SetInputs>> {
+    /// The set fit in `dir`, or None when `dir` holds a fit of one
+    /// photograph; the shots `hold_out` names held out besides the fit's.
+    pub fn from_fit_dir(dir: &Path, hold_out: &[String]) -> Result<Option<SetInputs>> {
         if !dir.join(crate::rundir::RESULT).is_file() {
             return Ok(None); // the one-photograph path says what is missing
         }
@@ -104,7 +109,9 @@ impl SetInputs {
             return Ok(None);
         };
         let scene = crate::scene::load(&dir.join(FITTED_SCENE))?;
-        let (shots, _) = crate::fit::set::shots::load(&dir.join(SHOTS), &scene)?;
+        let (mut shots, _) = crate::fit::set::shots::load(&dir.join(SHOTS), &scene)?;
+        crate::fit::set::held_out::mark(&mut shots, hold_out, "--hold-out")?;
+        let (shots, held_out) = crate::fit::set::held_out::split(&shots)?;
         let own = shots
             .iter()
             .map(|s| {
@@ -121,6 +128,11 @@ impl SetInputs {
                     })
             })
             .collect::<Result<Vec<_>>>()?;
-        Ok(Some(SetInputs { scene, shots, own }))
+        Ok(Some(SetInputs {
+            scene,
+            shots,
+            own,
+            held_out,
+        }))
     }
 }

@@ -99,6 +99,13 @@ pub fn write_set(
     }
     grid.push_str("</table>");
     page.raw(&grid);
+    crate::report::held_out::section(
+        &mut page,
+        out,
+        &inputs.held_out,
+        &d.held_out,
+        &d.held_out_images,
+    )?;
     candidates(&mut page, &d.diagnosis);
     write_atomic(&out.join(rundir::REPORT), page.finish().as_bytes())
 }

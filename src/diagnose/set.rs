@@ -27,15 +27,40 @@ use std::path::Path;
 /// Runs the diagnosis of a set, writing its files into `out`.
 pub fn run(inputs: &SetInputs, out: &Path, config: &DiagnoseConfig) -> Result<SetDiagnosis> {
     let found = super::diagnose(inputs, Schedule::Set, out, config)?;
+    let (held_out, held_out_images) = predictions(inputs, &found.model, config)?;
     let d = SetDiagnosis {
         diagnosis: found.diagnosis,
         shots_after: shots_after(inputs, &found.model, &found.before, &found.after),
+        held_out,
+        held_out_images,
     };
-    // A step on every photograph after the diagnosis (its prediction of
-    // photographs held out, say) goes here, from `found.model`.
     let (before, after) = &found.residuals;
     super::report::write_set(out, &d, &found.model, inputs, (before, after))?;
     Ok(d)
+}
+
+/// Each held-out photograph predicted by the fit's model and by `model`
+/// (a step on every photograph after the diagnosis goes here).
+fn predictions(
+    inputs: &SetInputs,
+    model: &Model,
+    c: &DiagnoseConfig,
+) -> Result<(
+    Vec<crate::fit::set::held_out::Compared>,
+    Vec<crate::raster::Image>,
+)> {
+    use crate::fit::set::held_out::{compare, search};
+    if inputs.held_out.is_empty() {
+        return Ok((Vec::new(), Vec::new()));
+    }
+    let renderer = crate::render::from_spec_with(&c.renderer, &c.render_options)?;
+    let models = (&inputs.scene, &model.scene);
+    compare(
+        models,
+        &inputs.held_out,
+        renderer.as_ref(),
+        search(c.seed, c.jobs),
+    )
 }
 
 /// Every photograph's own values after, and its deviations.

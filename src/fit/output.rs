@@ -50,6 +50,11 @@ pub struct FitResult {
     /// absent when the answer is unambiguous.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub alternatives: Vec<Alternative>,
+    /// A set's photographs held out of the fit (`"hold_out": true`,
+    /// `--hold-out`), each predicted from the fitted model
+    /// (`set::held_out`); absent when none was held out.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub held_out: Vec<HeldOutResult>,
 }
 
 /// One entry of result.json's `alternatives`: another answer, in the
@@ -127,6 +132,15 @@ pub struct ShotResult {
     /// This photograph's own parameters.
     pub params: serde_json::Map<String, serde_json::Value>,
     pub deviation: Deviation,
+}
+
+/// One held-out photograph in result.json: its own values as predicted
+/// (the shared ones frozen at the fit's) and the prediction's deviation.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct HeldOutResult {
+    pub name: String,
+    pub params: serde_json::Map<String, serde_json::Value>,
+    pub deviation_fit: Deviation,
 }
 
 impl FitResult {

@@ -113,6 +113,7 @@ pub fn build(cameras: Vec<Named>, images: &Path, out: &Path, source: &str) -> Re
             mask: None,
             encoding: None,
             set: c.camera.set_values(),
+            hold_out: false,
         });
     }
     Ok(ShotsFile {

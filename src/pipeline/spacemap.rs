@@ -544,6 +544,7 @@ fn finish(
         deviation_precise: None,
         shots: None,
         alternatives: Vec::new(),
+        held_out: Vec::new(),
     };
     result.check_finite()?;
     dir.write_json(FITTED_SCENE, &scene)?;

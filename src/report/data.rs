@@ -205,6 +205,7 @@ mod tests {
             identifiability: None,
             shots: None,
             alternatives: Vec::new(),
+            held_out: Vec::new(),
         };
         let c = read_progress(&p, &result).unwrap();
         assert_eq!(c.len(), 2);

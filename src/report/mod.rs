@@ -16,6 +16,7 @@ mod figure;
 pub mod font;
 mod format;
 pub mod heatmap;
+pub(crate) mod held_out;
 pub(crate) mod html;
 mod identifiability;
 pub mod images;

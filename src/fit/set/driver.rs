@@ -45,12 +45,13 @@ pub fn open(dir: &Path, shots: &[Shot], alone: bool, config: &FitConfig) -> Resu
 }
 
 /// Runs a fit of `scene` to `shots` by `plan`, in a run directory or
-/// (None) in memory only; `alone` as in [`Run`].
+/// (None) in memory only; `alone` as in [`Run`]; `held_out` are
+/// predicted at the end, not fitted.
 #[allow(clippy::too_many_arguments)]
 pub fn drive<P: Plan>(
     plan: &P,
     scene: &Scene,
-    shots: &[Shot],
+    (shots, held_out): (&[Shot], &[Shot]),
     renderer: &dyn Renderer,
     config: &SetConfig,
     dir: Option<&RunDir>,
@@ -58,6 +59,7 @@ pub fn drive<P: Plan>(
     observer: &mut dyn Observer,
 ) -> Result<P::Outcome> {
     let space = check_inputs(scene, shots, alone, &config.fit)?;
+    check_sizes(scene, held_out, alone)?;
     let run = Run {
         scene,
         shots,
@@ -66,6 +68,7 @@ pub fn drive<P: Plan>(
         dir,
         alone,
         space,
+        held_out,
     };
     let steps = plan.steps(&run)?;
     let mut state = initial_state(&run)?;
@@ -117,6 +120,16 @@ fn check_inputs(
             "the scene has no \"free\" parameters to fit".into(),
         ));
     }
+    check_sizes(scene, shots, alone)?;
+    config
+        .de
+        .validate()
+        .map_err(|e| Error::Usage(e.to_string()))?;
+    Ok(space)
+}
+
+/// Refuses a photograph whose size is not the scene's.
+fn check_sizes(scene: &Scene, shots: &[Shot], alone: bool) -> Result<()> {
     for s in shots {
         let (w, h) = s.target.image.dimensions();
         if (w, h) != (scene.image.width, scene.image.height) {
@@ -131,11 +144,7 @@ fn check_inputs(
             )));
         }
     }
-    config
-        .de
-        .validate()
-        .map_err(|e| Error::Usage(e.to_string()))?;
-    Ok(space)
+    Ok(())
 }
 
 /// A fresh run's first state, or a resumed run's state checked against
@@ -148,6 +157,7 @@ fn initial_state(run: &Run) -> Result<FitState> {
         .map(|s| RunIdentity::of(&s.scene, &s.target, &run.renderer.name(), config))
         .collect();
     let mut fresh = FitState::new(identities, if run.alone { 0 } else { run.config.rounds });
+    fresh.held_out = run.held_out.iter().map(|s| s.name.clone()).collect();
     if run.alone {
         fresh.base = Some(run.scene.clone());
     } else {

@@ -24,6 +24,7 @@
 //! result an uninterrupted run gives.
 
 pub(crate) mod driver;
+pub mod held_out;
 mod joint;
 mod outcome;
 pub(crate) mod phase;
@@ -42,7 +43,7 @@ pub use setup::SetConfig;
 
 use super::executor::{Halt, Offsets};
 use super::search_run::{halt_error, Logs, SearchRun};
-use super::{FitConfig, Observer};
+use super::Observer;
 use crate::error::Result;
 use crate::fit::problem::ShotsProblem;
 use crate::metric::Deviation;
@@ -52,7 +53,7 @@ use crate::rundir::RunDir;
 use crate::scene::{ParamSpace, Scene};
 use driver::drive;
 use run::{Plan, Run, Steps};
-use setup::{block_seed, varying};
+use setup::{block_config, block_seed, varying};
 pub use shots::Shot;
 use state::{FitState, Within};
 
@@ -60,9 +61,6 @@ use state::{FitState, Within};
 const ROUND_TOLERANCE: f64 = 0.01;
 /// Unit-cube spread of a later block's start around the current values.
 const LATER_RADIUS: f64 = 0.1;
-/// Generations without improvement that end a block when `--stagnation`
-/// is not given: a block is one step of an alternation, not the last word.
-const BLOCK_STAGNATION: usize = 30;
 
 /// Each shared coordinate's start spread in a shared block: a fresh fit's
 /// first block searches the whole box (the current values one member of
@@ -86,21 +84,9 @@ fn start_radii(shared: &ParamSpace, first: bool, config: &SetConfig) -> Vec<f64>
     radii
 }
 
-/// A block's search options: the run's, with a population of ten per
-/// coordinate (DE's usual rule; at least 16, at most the run's) and a
-/// stagnation stop.
-fn block_config(config: &FitConfig, dim: usize, seed: u64) -> FitConfig {
-    let mut c = config.clone();
-    c.de.seed = seed;
-    c.de.population = (10 * dim).clamp(16, config.de.population.max(16));
-    c.stagnation = Some(config.stagnation.unwrap_or(BLOCK_STAGNATION));
-    c.phase_generations = None;
-    c
-}
-
-/// Runs a set fit, in a run directory (opened by `driver::open`) or
-/// (None) in memory only: the one fit path (`driver`) with the set's
-/// blocks.
+/// Runs a set fit of every one of `shots`, in a run directory (opened
+/// by `driver::open`) or (None) in memory only: the one fit path
+/// (`driver`) with the set's blocks.
 pub fn run_in(
     scene: &Scene,
     shots: &[Shot],
@@ -109,6 +95,24 @@ pub fn run_in(
     dir: Option<&RunDir>,
     observer: &mut dyn Observer,
 ) -> Result<SetOutcome> {
+    let shots = (shots, &[][..]);
+    drive(
+        &Blocks, scene, shots, renderer, config, dir, false, observer,
+    )
+}
+
+/// [`run_in`] with the shots marked `hold_out` left out of the fit and
+/// predicted after it (`held_out`); refused when every one is held out.
+pub fn run_holding_out(
+    scene: &Scene,
+    shots: &[Shot],
+    renderer: &dyn Renderer,
+    config: &SetConfig,
+    dir: Option<&RunDir>,
+    observer: &mut dyn Observer,
+) -> Result<SetOutcome> {
+    let (fitted, held) = held_out::split(shots)?;
+    let shots = (fitted.as_slice(), held.as_slice());
     drive(
         &Blocks, scene, shots, renderer, config, dir, false, observer,
     )
@@ -166,15 +170,7 @@ impl Plan for Blocks {
     }
 
     fn finish(&self, run: &Run, state: &FitState) -> Result<SetOutcome> {
-        outcome::finish(
-            state,
-            run.scene,
-            run.shots,
-            run.renderer,
-            run.config,
-            &run.space,
-            run.dir,
-        )
+        outcome::finish(state, run)
     }
 }
 

@@ -1,9 +1,13 @@
 //! What a set fit returns and writes: result.json (the shared parameters,
-//! the deviation over every photograph, and `shots` with each one's own
-//! parameters and deviation), fitted_scene.json (the shared model), one
-//! best image per photograph, and shots.json (the photographs with
-//! absolute paths, for `diagnose`).
+//! the deviation over every photograph, `shots` with each one's own
+//! parameters and deviation, and `held_out`, each held-out photograph's
+//! prediction), fitted_scene.json (the shared model), one best image per
+//! photograph (a held-out one's: its prediction), and shots.json (the
+//! photographs with absolute paths, held-out ones marked, for
+//! `diagnose`).
 
+use super::held_out::{predict, Prediction};
+use super::run::Run;
 use super::state::FitState;
 use super::{varying, SetConfig, ShotResult};
 use crate::error::{Error, Result};
@@ -35,18 +39,15 @@ pub struct SetOutcome {
     /// The shared model (per-shot fields as the scene gives them).
     pub scene: Scene,
     pub shots: Vec<ShotOutcome>,
+    /// Each photograph held out of the fit, predicted from its model.
+    pub held_out: Vec<Prediction>,
 }
 
-/// Renders every photograph at the final values, and writes the outputs.
-pub fn finish(
-    state: &FitState,
-    scene: &Scene,
-    shots: &[Shot],
-    renderer: &dyn Renderer,
-    config: &SetConfig,
-    space: &ParamSpace,
-    dir: Option<&RunDir>,
-) -> Result<SetOutcome> {
+/// Renders every photograph at the final values, predicts each held-out
+/// one, and writes the outputs.
+pub fn finish(state: &FitState, run: &Run) -> Result<SetOutcome> {
+    let (scene, shots, renderer, config) = (run.scene, run.shots, run.renderer, run.config);
+    let (space, dir) = (&run.space, run.dir);
     let shared = space.shared();
     let scenes: Vec<Scene> = shots
         .iter()
@@ -80,15 +81,20 @@ pub fn finish(
         identifiability: identifiability(state, &shared, config),
         shots: Some(outs.iter().map(|o| o.result.clone()).collect()),
         alternatives: Vec::new(),
+        held_out: Vec::new(),
     };
     result.check_finite()?;
-    let outcome = SetOutcome {
+    let model = shared.scene_at(scene, &state.shared);
+    let held_out = predict(&model, run.held_out, renderer, &config.fit, dir)?;
+    let mut outcome = SetOutcome {
         result,
-        scene: shared.scene_at(scene, &state.shared),
+        scene: model,
         shots: outs,
+        held_out,
     };
+    outcome.result.held_out = outcome.held_out.iter().map(|p| p.result.clone()).collect();
     if let Some(d) = dir {
-        write(d, &outcome, shots)?;
+        write(d, &outcome, shots, run.held_out)?;
     }
     Ok(outcome)
 }
@@ -171,12 +177,14 @@ fn precise(outs: &[ShotOutcome], shots: &[Shot]) -> Option<Deviation> {
     Some(Deviation::pooled(&parts))
 }
 
-/// The set's files, through the one writer (`fit::output`).
-fn write(dir: &RunDir, outcome: &SetOutcome, shots: &[Shot]) -> Result<()> {
+/// The set's files, through the one writer (`fit::output`): the held-out
+/// photographs listed after the fitted ones, marked.
+fn write(dir: &RunDir, outcome: &SetOutcome, shots: &[Shot], held_out: &[Shot]) -> Result<()> {
     let file = ShotsFile {
         format: FORMAT.into(),
         shots: shots
             .iter()
+            .chain(held_out)
             .map(|s| {
                 let mut e = s.entry.clone();
                 e.target = absolute(&e.target);
@@ -185,10 +193,11 @@ fn write(dir: &RunDir, outcome: &SetOutcome, shots: &[Shot]) -> Result<()> {
             })
             .collect(),
     };
-    let images = outcome
-        .shots
-        .iter()
-        .map(|o| (shot_best_name(&o.result.name), &o.image))
+    let fitted = outcome.shots.iter().map(|o| (&o.result.name, &o.image));
+    let predicted = outcome.held_out.iter().map(|p| (&p.result.name, &p.image));
+    let images = fitted
+        .chain(predicted)
+        .map(|(name, image)| (shot_best_name(name), image))
         .collect();
     let written = Written {
         images,

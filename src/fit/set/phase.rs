@@ -63,7 +63,14 @@ pub fn run_one(
     let shots = [Shot::one(scene, target.clone())];
     let config = SetConfig::one(config.clone());
     drive(
-        &Phases, scene, &shots, renderer, &config, dir, true, observer,
+        &Phases,
+        scene,
+        (&shots, &[]),
+        renderer,
+        &config,
+        dir,
+        true,
+        observer,
     )
 }
 
@@ -187,6 +194,7 @@ fn finish(
             .map(|id| uncertainty::of(&sub, &id)),
         shots: None,
         alternatives: output::alternatives(&sub, &base, search.best().0, &search.alternatives()),
+        held_out: Vec::new(),
     };
     result.check_finite()?;
     state.within.search = Some(search);

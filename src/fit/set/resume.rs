@@ -34,6 +34,13 @@ pub fn check(s: &FitState, file: &str, run: &Run, fresh: &FitState) -> Result<()
         check_one(s, file)?;
     }
     let mismatch = |what: String| refuse(file, &what);
+    if s.held_out != fresh.held_out {
+        return Err(mismatch(format!(
+            "the photographs held out were [{}], now [{}]",
+            s.held_out.join(", "),
+            fresh.held_out.join(", ")
+        )));
+    }
     if s.identities.len() != fresh.identities.len() {
         return Err(mismatch(format!(
             "the shots file listed {} photographs, now {}",

@@ -26,6 +26,9 @@ pub struct Run<'a> {
     pub alone: bool,
     /// The scene's free parameters.
     pub space: ParamSpace,
+    /// A set's photographs held out of the fit, predicted at its end
+    /// (`held_out`).
+    pub held_out: &'a [Shot],
 }
 
 /// How a fit proceeds: its steps in order, each run over the one state,

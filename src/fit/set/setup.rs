@@ -1,10 +1,15 @@
 //! How a set fit is set up: its options (`SetConfig`), every field its
-//! renders vary, and each block's seed; what the blocks, the joint block,
-//! the outcome and the state between blocks share.
+//! renders vary, and each block's seed and search options; what the
+//! blocks, the joint block, the outcome, the predictions of held-out
+//! photographs and the state between blocks share.
 
 use super::shots::Shot;
 use crate::fit::FitConfig;
 use crate::scene::{Field, ParamSpace, ParamSpec};
+
+/// Generations without improvement that end a block when `--stagnation`
+/// is not given: a block is one step of an alternation, not the last word.
+const BLOCK_STAGNATION: usize = 30;
 
 /// How a set fit runs: each block as `fit` (search options, budget per
 /// block), and how many rounds at most.
@@ -84,4 +89,16 @@ pub fn varying(space: &ParamSpace, shots: &[Shot]) -> ParamSpace {
 pub fn block_seed(seed: u64, block: usize, shot: usize) -> u64 {
     seed.wrapping_add((block as u64 + 1).wrapping_mul(0x9E37_79B9_7F4A_7C15))
         .wrapping_add((shot as u64).wrapping_mul(0xBF58_476D_1CE4_E5B9))
+}
+
+/// A block's search options: the run's, with a population of ten per
+/// coordinate (DE's usual rule; at least 16, at most the run's) and a
+/// stagnation stop.
+pub fn block_config(config: &FitConfig, dim: usize, seed: u64) -> FitConfig {
+    let mut c = config.clone();
+    c.de.seed = seed;
+    c.de.population = (10 * dim).clamp(16, config.de.population.max(16));
+    c.stagnation = Some(config.stagnation.unwrap_or(BLOCK_STAGNATION));
+    c.phase_generations = None;
+    c
 }

@@ -6,8 +6,12 @@
 //! ```json
 //! {"format": "scenefit-shots/1",
 //!  "shots": [{"name": "001", "target": "001.png", "mask": "mask.png",
-//!             "encoding": "srgb", "set": {"lights.led.intensity": 2.5}}]}
+//!             "encoding": "srgb", "set": {"lights.led.intensity": 2.5}},
+//!            {"name": "002", "target": "002.png", "hold_out": true}]}
 //! ```
+//!
+//! A shot marked `hold_out` takes no part in the fit; it is predicted
+//! after it (`held_out`).
 
 use crate::error::{Error, Result};
 use crate::fit::FitTarget;
@@ -47,6 +51,9 @@ pub struct Entry {
     /// Known values of this photograph (param paths, as `--set` takes).
     #[serde(default, skip_serializing_if = "serde_json::Map::is_empty")]
     pub set: serde_json::Map<String, serde_json::Value>,
+    /// Held out of the fit, and predicted after it (`held_out`).
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub hold_out: bool,
 }
 
 /// One photograph, ready to fit.
@@ -71,6 +78,7 @@ impl Shot {
             mask: None,
             encoding: None,
             set: Default::default(),
+            hold_out: false,
         };
         Shot {
             name: entry.name.clone(),

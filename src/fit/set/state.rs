@@ -60,6 +60,10 @@ pub struct FitState {
     /// (result.json's `identifiability`).
     #[serde(default)]
     pub last_shared: Option<Searcher>,
+    /// The names of a set's photographs held out of the fit: part of
+    /// what defines the run (a resume holding out others is refused).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub held_out: Vec<String>,
 }
 
 /// The progress within the step in progress (empty between steps but
@@ -112,6 +116,7 @@ impl FitState {
             seconds: 0.0,
             within: Within::default(),
             last_shared: None,
+            held_out: Vec::new(),
         }
     }
 
