@@ -12,7 +12,7 @@ use crate::error::{Error, Result};
 use crate::fsio::write_atomic;
 use crate::metric::Deviation;
 use crate::raster::{io as image_io, Image};
-use crate::report::html::{esc, href, Page};
+use crate::report::html::{esc, thumb_cell, Page};
 use crate::rundir;
 use crate::scene::Scene;
 use std::path::Path;
@@ -81,12 +81,7 @@ pub fn write_set(
     ));
     let mut grid = String::from("<table>\n<tr><th class=\"l\">shot</th><th>deviation before</th><th>after</th><th>residual before</th><th>residual after</th><th>render after</th></tr>\n");
     for s in &d.shots_after {
-        let img = |f: String| {
-            format!(
-                "<td><img class=\"px\" style=\"width:192px\" src=\"{}\" alt=\"\"></td>",
-                href(&f)
-            )
-        };
+        let img = |f: String| thumb_cell(&f);
         grid.push_str(&format!(
             "<tr><td class=\"l\">{}</td><td>{:.3}</td><td>{:.3}</td>{}{}{}</tr>\n",
             esc(&s.name),

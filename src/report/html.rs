@@ -31,6 +31,15 @@ pub fn href(path: &str) -> String {
     out
 }
 
+/// A table cell holding a run-directory image at the grid's thumbnail
+/// width (pixels drawn square, not smoothed).
+pub fn thumb_cell(file: &str) -> String {
+    format!(
+        "<td><img class=\"px\" style=\"width:192px\" src=\"{}\" alt=\"\"></td>",
+        href(file)
+    )
+}
+
 const STYLE: &str = r#"
 body { font-family: system-ui, -apple-system, "DejaVu Sans", sans-serif; margin: 2em auto; max-width: 1720px; padding: 0 1em; color: #222; }
 h1 { font-size: 1.6em; } h2 { font-size: 1.25em; margin-top: 2em; border-bottom: 1px solid #ccc; }

@@ -177,19 +177,7 @@ mod tests {
         let p = (0..8)
             .map(|k| [0, 1, 2].map(|a| if k >> a & 1 == 0 { -1.0 } else { 1.0 }))
             .collect();
-        let mut t = Vec::new();
-        for f in [
-            [0, 1, 3, 2],
-            [4, 6, 7, 5],
-            [0, 4, 5, 1],
-            [2, 3, 7, 6],
-            [0, 2, 6, 4],
-            [1, 5, 7, 3],
-        ] {
-            t.push([f[0], f[1], f[2]]);
-            t.push([f[0], f[2], f[3]]);
-        }
-        (p, t)
+        (p, super::super::trimesh::cube_triangles())
     }
 
     /// Crossings by brute force, Möller–Trumbore over every triangle.

@@ -361,6 +361,25 @@ impl Placed {
 }
 
 #[cfg(test)]
+/// The twelve triangles of a closed box whose corner k has coordinate
+/// a at +1 when bit a of k is set (outward winding).
+pub(super) fn cube_triangles() -> Vec<[u32; 3]> {
+    let mut t = Vec::new();
+    for f in [
+        [0, 1, 3, 2],
+        [4, 6, 7, 5],
+        [0, 4, 5, 1],
+        [2, 3, 7, 6],
+        [0, 2, 6, 4],
+        [1, 5, 7, 3],
+    ] {
+        t.push([f[0], f[1], f[2]]);
+        t.push([f[0], f[2], f[3]]);
+    }
+    t
+}
+
+#[cfg(test)]
 mod tests {
     use super::*;
 
@@ -371,18 +390,7 @@ mod tests {
                 [0, 1, 2].map(|a| (if k >> a & 1 == 0 { -1.0 } else { 1.0 }) * [1.0, 0.6, 0.3][a])
             })
             .collect();
-        let mut triangles = Vec::new();
-        for f in [
-            [0, 1, 3, 2],
-            [4, 6, 7, 5],
-            [0, 4, 5, 1],
-            [2, 3, 7, 6],
-            [0, 2, 6, 4],
-            [1, 5, 7, 3],
-        ] {
-            triangles.push([f[0], f[1], f[2]]);
-            triangles.push([f[0], f[2], f[3]]);
-        }
+        let triangles = cube_triangles();
         Mesh {
             positions,
             normals: Vec::new(),
