@@ -70,8 +70,12 @@ mod tests {
 
     #[test]
     fn a_failing_script_keeps_what_it_printed() {
-        let spec = CommandSpec::new("sh")
-            .args(["-c", "echo first; echo 'scenefit-error: bad' >&2; exit 3"]);
+        // one stream: stdout and stderr are drained side by side, so their
+        // relative order is not kept (callers search every line)
+        let spec = CommandSpec::new("sh").args([
+            "-c",
+            "echo first >&2; echo 'scenefit-error: bad' >&2; exit 3",
+        ]);
         let ran = run(&spec, TIME_LIMIT).unwrap();
         assert!(ran.failure.unwrap().contains("status 3"));
         assert!(ran.text.contains("scenefit-error: bad"), "{}", ran.text);
