@@ -6,7 +6,7 @@
 //! declares the camera response of linear photographs, `ROUNDS=n` bounds
 //! the effects the diagnosis may add (default 2).
 
-use scenefit::diagnose::{self, photo, DiagnoseConfig, Inputs};
+use scenefit::diagnose::{self, photo, DiagnoseConfig, Inputs, SetInputs};
 use scenefit::fit::{self, FitConfig, FitTarget};
 use scenefit::metric::Mask;
 use scenefit::optimize::DeConfig;
@@ -111,11 +111,11 @@ fn main() {
         let err = photo::angle_deg(d, g);
         errors.push(err);
         let t = std::time::Instant::now();
-        let inputs = Inputs {
+        let inputs = SetInputs::one(&Inputs {
             scene: fitted,
             target,
             mask: Some(mask),
-        };
+        });
         let diag = diagnose::run(
             &inputs,
             &dir.join("diagnose"),
@@ -128,7 +128,8 @@ fn main() {
                 ..DiagnoseConfig::default()
             },
         )
-        .expect("diagnose");
+        .expect("diagnose")
+        .diagnosis;
         let after = diag
             .params_after
             .get("lights.led.direction")

@@ -6,7 +6,7 @@
 mod effects_data;
 
 use effects_data::{case, effects, fit_case};
-use scenefit::diagnose::{self, DiagnoseConfig, Inputs};
+use scenefit::diagnose::{self, DiagnoseConfig, Inputs, SetInputs};
 
 fn diagnose_case(effect: &str, variant: u32, seed: u64, noise: f64) -> diagnose::Diagnosis {
     diagnose_case_with(effect, variant, seed, noise, DiagnoseConfig::default().jobs)
@@ -29,14 +29,16 @@ fn diagnose_case_with(
     let fit_dir = dir.join("fit");
     std::fs::create_dir_all(&fit_dir).unwrap();
     fit_case(&c, &fit_dir, seed);
-    let inputs = Inputs::from_fit_dir(&fit_dir, None, None).unwrap();
+    let inputs = SetInputs::one(&Inputs::from_fit_dir(&fit_dir, None, None).unwrap());
     let config = DiagnoseConfig {
         max_rounds: 1,
         seed,
         jobs,
         ..DiagnoseConfig::default()
     };
-    diagnose::run(&inputs, &dir.join("diag"), &config).unwrap()
+    diagnose::run(&inputs, &dir.join("diag"), &config)
+        .unwrap()
+        .diagnosis
 }
 
 #[test]

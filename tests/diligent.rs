@@ -86,11 +86,11 @@ fn diagnosis_of_a_photograph_brings_the_light_closer() {
         .result;
     let fitted = load(&dir.path().join("fitted_scene.json")).unwrap();
     let before = angle(&fitted, truth);
-    let inputs = scenefit::diagnose::Inputs {
+    let inputs = scenefit::diagnose::SetInputs::one(&scenefit::diagnose::Inputs {
         scene: fitted,
         target,
         mask: Some(mask),
-    };
+    });
     let d = scenefit::diagnose::run(
         &inputs,
         &dir.path().join("diagnose"),
@@ -100,7 +100,8 @@ fn diagnosis_of_a_photograph_brings_the_light_closer() {
             ..Default::default()
         },
     )
-    .unwrap();
+    .unwrap()
+    .diagnosis;
     let improved = load(&dir.path().join("diagnose/improved_scene.json")).unwrap();
     let after = angle(&improved, truth);
     let summary = format!(

@@ -239,6 +239,14 @@ fn a_set_diagnosis_predicts_the_held_out_photographs_before_and_after() {
         .map(|s| s["name"].as_str().unwrap())
         .collect();
     assert_eq!(held, ["s0", "s4"], "the diagnosis's and the fit's");
+    // The fit's prediction of the shot it held out is its own figure, not
+    // a second prediction by the diagnosis's search.
+    let fitted = read_json(&fit_dir.join("result.json"));
+    assert_eq!(fitted["held_out"][0]["name"], "s4");
+    assert_eq!(
+        d["held_out"][1]["deviation_fit"], fitted["held_out"][0]["deviation_fit"],
+        "result.json's deviation_fit"
+    );
     for h in d["held_out"].as_array().unwrap() {
         for key in ["deviation_fit", "deviation_after"] {
             let v = h[key]["average"].as_f64().unwrap();

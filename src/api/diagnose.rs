@@ -3,8 +3,7 @@
 //! run-directory rule (locked, fresh unless `overwrite`, never the fit
 //! directory, no input inside it replaced), then `crate::diagnose` run.
 
-use crate::diagnose::set::SetInputs;
-use crate::diagnose::{self, DiagnoseConfig, Diagnosis, Inputs};
+use crate::diagnose::{self, DiagnoseConfig, Diagnosis, Inputs, SetInputs};
 use crate::error::{Error, Result};
 use crate::rundir::{Kind, Mode, RunDir, SHOTS};
 use crate::scene::memory::Population;
@@ -29,14 +28,8 @@ pub struct DiagnoseRequest {
     pub config: DiagnoseConfig,
 }
 
-/// What the fit directory holds: a set of photographs, or one.
-enum Fitted {
-    Set(SetInputs),
-    One(Inputs),
-}
-
-/// Diagnoses the fit in `r.fit_dir` into `r.output`; a set's diagnosis is
-/// returned as its pooled part.
+/// Diagnoses the fit in `r.fit_dir` (one photograph or a set) into
+/// `r.output`; returned as its pooled part.
 pub fn diagnose(r: &DiagnoseRequest) -> Result<Diagnosis> {
     let set = SetInputs::from_fit_dir(&r.fit_dir, &r.hold_out)?;
     if set.is_none() && !r.hold_out.is_empty() {
@@ -54,9 +47,10 @@ pub fn diagnose(r: &DiagnoseRequest) -> Result<Diagnosis> {
     // refused diagnosis says only why.
     let out = open_output(r)?;
     refuse_inputs(&out, r, set.as_ref())?;
-    let fitted = match set {
-        Some(s) => Fitted::Set(s),
-        None => Fitted::One(Inputs::from_fit_dir(
+    // One photograph is a set of one, read once the output is held.
+    let inputs = match set {
+        Some(s) => s,
+        None => SetInputs::one(&Inputs::from_fit_dir(
             &r.fit_dir,
             r.target.as_deref(),
             r.mask.as_deref(),
@@ -66,10 +60,7 @@ pub fn diagnose(r: &DiagnoseRequest) -> Result<Diagnosis> {
     if r.overwrite {
         out.clear()?;
     }
-    Ok(match fitted {
-        Fitted::Set(set) => diagnose::set::run(&set, &r.output, &r.config)?.diagnosis,
-        Fitted::One(inputs) => diagnose::run(&inputs, &r.output, &r.config)?,
-    })
+    Ok(diagnose::run(&inputs, &r.output, &r.config)?.diagnosis)
 }
 
 /// The output directory, locked, by the run-directory rule; never the fit

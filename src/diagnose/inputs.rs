@@ -5,7 +5,7 @@
 
 use crate::error::{Error, Result};
 use crate::fit::set::shots::Shot;
-use crate::fit::{FitResult, FitTarget};
+use crate::fit::{FitResult, FitTarget, HeldOutResult};
 use crate::metric::Mask;
 use crate::raster::Encoding;
 use crate::raster::Image;
@@ -76,6 +76,13 @@ pub struct SetInputs {
     /// Photographs held out (by the fit or `diagnose --hold-out`): in no
     /// refit, predicted at the end (`fit::set::held_out`).
     pub held_out: Vec<Shot>,
+    /// The fit's own predictions of the shots it held out (result.json's
+    /// `held_out`): their `deviation_fit` is taken as the fit reported it,
+    /// not predicted again.
+    pub fit_held_out: Vec<HeldOutResult>,
+    /// A fit of one photograph (`--target`), not a shots file: its models
+    /// are refitted as one photograph's and its files carry no shot name.
+    pub single: bool,
 }
 
 impl SetInputs {
@@ -94,6 +101,8 @@ impl SetInputs {
             shots: vec![Shot::one(&inputs.scene, target)],
             own: vec![Params::new()],
             held_out: Vec::new(),
+            fit_held_out: Vec::new(),
+            single: true,
         }
     }
 
@@ -133,6 +142,8 @@ impl SetInputs {
             shots,
             own,
             held_out,
+            fit_held_out: result.held_out,
+            single: false,
         }))
     }
 }

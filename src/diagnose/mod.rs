@@ -36,25 +36,24 @@ mod lanes;
 mod model;
 mod one_refit;
 pub mod photo;
+mod predictions;
 mod refits;
 pub mod report;
 pub mod residual;
 mod rounds;
 mod schedule;
 mod selection;
-pub mod set;
 mod set_refit;
 mod starts;
 mod trials;
 
 pub use config::DiagnoseConfig;
-pub use diagnosis::{Candidate, Diagnosis, UNEXPLAINED};
-pub use inputs::Inputs;
+pub use diagnosis::{Candidate, Diagnosis, SetDiagnosis, ShotAfter, UNEXPLAINED};
+pub use inputs::{Inputs, SetInputs};
 
 use crate::error::{Error, Result};
 use crate::metric::Deviation;
-use crate::render::from_spec_with;
-use inputs::SetInputs;
+use crate::render::{from_spec_with, Renderer};
 use model::{pooled, Model};
 use refits::Refits;
 use residual::Residual;
@@ -64,17 +63,23 @@ use selection::samples;
 use std::path::Path;
 use std::time::Instant;
 
-/// Runs the diagnosis of one photograph, writing its files into `out`:
-/// the diagnosis of a set of one (`SetInputs::one`), its models refitted
-/// as one photograph's (`Schedule::One`).
-pub fn run(inputs: &Inputs, out: &Path, config: &DiagnoseConfig) -> Result<Diagnosis> {
-    let one = SetInputs::one(inputs);
-    let found = diagnose(&one, Schedule::One, out, config)?;
+/// Runs the diagnosis of a fit, one photograph (a set of one) or a set,
+/// writing its files into `out`; held-out photographs are predicted after
+/// it by the same renderer.
+pub fn run(inputs: &SetInputs, out: &Path, config: &DiagnoseConfig) -> Result<SetDiagnosis> {
+    let renderer = from_spec_with(&config.renderer, &config.render_options)?;
+    let found = diagnose(inputs, Schedule::of(inputs), out, config, renderer.as_ref())?;
+    let (held_out, held_out_images) =
+        predictions::held_out(inputs, &found.model, config, renderer.as_ref())?;
+    let d = SetDiagnosis {
+        shots_after: predictions::shots_after(inputs, &found.model, &found.before, &found.after),
+        diagnosis: found.diagnosis,
+        held_out,
+        held_out_images,
+    };
     let (before, after) = &found.residuals;
-    let image = &found.model.images[0];
-    let residuals = (&before[0], &after[0]);
-    report::write(out, &found.diagnosis, &found.model.scene, image, residuals)?;
-    Ok(found.diagnosis)
+    report::write(out, &d, &found.model, inputs, (before, after))?;
+    Ok(d)
 }
 
 /// What a diagnosis found, before its files are written: diagnosis.json's
@@ -98,13 +103,13 @@ fn diagnose(
     schedule: Schedule,
     out: &Path,
     config: &DiagnoseConfig,
+    renderer: &dyn Renderer,
 ) -> Result<Outcome> {
     let started = Instant::now();
     std::fs::create_dir_all(out).map_err(|e| Error::io(out, e))?;
-    let renderer = from_spec_with(&config.renderer, &config.render_options)?;
     let (scene, held) = held::split(&inputs.scene, config.refit_geometry);
     let mut fits = Refits {
-        renderer: renderer.as_ref(),
+        renderer,
         inputs,
         config,
         schedule,

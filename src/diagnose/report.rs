@@ -11,39 +11,21 @@ use super::residual::Residual;
 use crate::error::{Error, Result};
 use crate::fsio::write_atomic;
 use crate::metric::Deviation;
-use crate::raster::{io as image_io, Image};
+use crate::raster::io as image_io;
 use crate::report::html::{esc, thumb_cell, Page};
 use crate::rundir;
-use crate::scene::Scene;
 use std::path::Path;
 
 fn json(value: &impl serde::Serialize) -> Result<String> {
     serde_json::to_string_pretty(value).map_err(|e| Error::Run(e.to_string()))
 }
 
-/// Writes every file of the diagnosis `d` into `out`; `residuals` are the
-/// residuals before and after.
+/// Writes every file of the diagnosis `d` into `out`: diagnosis.json, the
+/// improved scene, and for every photograph its residual before and after
+/// (on one scale) and its render after; `residuals` are the residuals
+/// before and after, one per photograph. A fit of one photograph keeps
+/// its files without a shot name and diagnosis.json without `shots_after`.
 pub fn write(
-    out: &Path,
-    d: &Diagnosis,
-    scene: &Scene,
-    image: &Image,
-    residuals: (&Residual, &Residual),
-) -> Result<()> {
-    let (before, after) = residuals;
-    write_atomic(&out.join(rundir::DIAGNOSIS_JSON), json(d)?.as_bytes())?;
-    write_atomic(&out.join(rundir::IMPROVED_SCENE), json(scene)?.as_bytes())?;
-    let scale = before.peak().max(after.peak()).max(1e-3);
-    image_io::write_image(&before.heatmap(scale), &out.join(rundir::RESIDUAL_BEFORE))?;
-    image_io::write_image(&after.heatmap(scale), &out.join(rundir::RESIDUAL_AFTER))?;
-    image_io::write_image(image, &out.join(rundir::RENDER_AFTER))?;
-    write_atomic(&out.join(rundir::REPORT), html(d, scale).as_bytes())
-}
-
-/// Writes every file of the set diagnosis `d` into `out`: diagnosis.json,
-/// the improved shared scene, and for every photograph its render after
-/// and its residual before and after, shown in a grid on the page.
-pub fn write_set(
     out: &Path,
     d: &SetDiagnosis,
     model: &Model,
@@ -51,7 +33,12 @@ pub fn write_set(
     residuals: (&[Residual], &[Residual]),
 ) -> Result<()> {
     let (before, after) = residuals;
-    write_atomic(&out.join(rundir::DIAGNOSIS_JSON), json(d)?.as_bytes())?;
+    let record = if inputs.single {
+        json(&d.diagnosis)?
+    } else {
+        json(d)?
+    };
+    write_atomic(&out.join(rundir::DIAGNOSIS_JSON), record.as_bytes())?;
     write_atomic(
         &out.join(rundir::IMPROVED_SCENE),
         json(&model.scene)?.as_bytes(),
@@ -62,17 +49,49 @@ pub fn write_set(
         .map(Residual::peak)
         .fold(1e-3, f64::max);
     for (i, s) in inputs.shots.iter().enumerate() {
-        let name = &s.name;
-        image_io::write_image(
-            &before[i].heatmap(scale),
-            &out.join(rundir::shot_residual_before(name)),
-        )?;
-        image_io::write_image(
-            &after[i].heatmap(scale),
-            &out.join(rundir::shot_residual_after(name)),
-        )?;
-        image_io::write_image(&model.images[i], &out.join(rundir::shot_render_after(name)))?;
+        let [b, a, r] = files(inputs, &s.name);
+        image_io::write_image(&before[i].heatmap(scale), &out.join(b))?;
+        image_io::write_image(&after[i].heatmap(scale), &out.join(a))?;
+        image_io::write_image(&model.images[i], &out.join(r))?;
     }
+    let mut page = if inputs.single {
+        html(&d.diagnosis, scale)
+    } else {
+        set_html(d, scale)
+    };
+    crate::report::held_out::section(
+        &mut page,
+        out,
+        &inputs.held_out,
+        &d.held_out,
+        &d.held_out_images,
+    )?;
+    candidates(&mut page, &d.diagnosis);
+    write_atomic(&out.join(rundir::REPORT), page.finish().as_bytes())
+}
+
+/// A photograph's residual before, after, and render after, as named in
+/// the run directory.
+fn files(inputs: &SetInputs, name: &str) -> [String; 3] {
+    if inputs.single {
+        [
+            rundir::RESIDUAL_BEFORE,
+            rundir::RESIDUAL_AFTER,
+            rundir::RENDER_AFTER,
+        ]
+        .map(String::from)
+    } else {
+        [
+            rundir::shot_residual_before(name),
+            rundir::shot_residual_after(name),
+            rundir::shot_render_after(name),
+        ]
+    }
+}
+
+/// A set's page up to its candidates: the verdict, and every photograph's
+/// deviations and images in a grid.
+fn set_html(d: &SetDiagnosis, scale: f64) -> Page {
     let mut page = Page::new("scenefit diagnosis of a set of photographs");
     summary(&mut page, &d.diagnosis);
     page.h2("Every photograph", "shots");
@@ -94,15 +113,7 @@ pub fn write_set(
     }
     grid.push_str("</table>");
     page.raw(&grid);
-    crate::report::held_out::section(
-        &mut page,
-        out,
-        &inputs.held_out,
-        &d.held_out,
-        &d.held_out_images,
-    )?;
-    candidates(&mut page, &d.diagnosis);
-    write_atomic(&out.join(rundir::REPORT), page.finish().as_bytes())
+    page
 }
 
 fn dev_row(name: &str, v: &Deviation) -> Vec<String> {
@@ -110,7 +121,9 @@ fn dev_row(name: &str, v: &Deviation) -> Vec<String> {
     vec![name.into(), f(v.r), f(v.g), f(v.b), f(v.average)]
 }
 
-fn html(d: &Diagnosis, scale: f64) -> String {
+/// One photograph's page up to its candidates: the verdict and its
+/// residual before and after.
+fn html(d: &Diagnosis, scale: f64) -> Page {
     let mut page = Page::new("scenefit diagnosis");
     summary(&mut page, d);
     page.h2("Residual (target − render)", "residual");
@@ -119,8 +132,7 @@ fn html(d: &Diagnosis, scale: f64) -> String {
     ));
     page.figure_enlarged(rundir::RESIDUAL_BEFORE, "before", 384);
     page.figure_enlarged(rundir::RESIDUAL_AFTER, "after", 384);
-    candidates(&mut page, d);
-    page.finish()
+    page
 }
 
 /// The verdict and the deviations before, refitted and after.
@@ -249,7 +261,9 @@ mod tests {
                 reason: "vignetting and ambient explain the same residual".into(),
             }],
         };
-        let page = html(&d, 0.05);
+        let mut page = html(&d, 0.05);
+        candidates(&mut page, &d);
+        let page = page.finish();
         for part in [
             "<b>vignetting</b>. 1234 renders in 5.0 s.",
             "Imitation: vignetting and ambient explain the same residual.",

@@ -15,6 +15,17 @@ pub enum Schedule {
     Set,
 }
 
+impl Schedule {
+    /// The refits of the fit `inputs` come from.
+    pub fn of(inputs: &super::inputs::SetInputs) -> Schedule {
+        if inputs.single {
+            Schedule::One
+        } else {
+            Schedule::Set
+        }
+    }
+}
+
 /// One refit of a trial.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Refit {

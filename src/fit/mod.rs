@@ -25,7 +25,7 @@ pub(crate) mod uncertainty;
 
 pub use config::{FitConfig, GenerationReport};
 pub use executor::{Observer, Problem};
-pub use output::{Alternative, FitOutcome, FitResult, Population};
+pub use output::{Alternative, FitOutcome, FitResult, HeldOutResult, Population};
 pub use problem::{counted, render_seed};
 pub use set::saved::load as load_state;
 pub use set::state::FitState;

@@ -167,28 +167,45 @@ pub fn search(seed: u64, jobs: usize) -> FitConfig {
     }
 }
 
-/// Each of `held_out` predicted from the fit's model and from the
-/// improved model (`models`), with the same search (`config`): the
-/// entries, and the predictions after.
+/// Each of `held_out` predicted from the improved model (`models.1`) and,
+/// unless the fit already did (`known`, result.json's `held_out`), from
+/// the fit's model (`models.0`), with the same search (`config`): the
+/// entries, and the predictions after. A prediction the fit made is taken
+/// as it reported it, so that diagnosis.json's `deviation_fit` is the
+/// figure of result.json.
 pub fn compare(
     (fitted, after): (&Scene, &Scene),
     held_out: &[Shot],
+    known: &[HeldOutResult],
     renderer: &dyn Renderer,
     config: FitConfig,
 ) -> Result<(Vec<Compared>, Vec<Image>)> {
-    let before = predict(fitted, held_out, renderer, &config, None)?;
+    let found = |s: &Shot| known.iter().find(|k| k.name == s.name);
+    let new: Vec<Shot> = held_out
+        .iter()
+        .filter(|s| found(s).is_none())
+        .cloned()
+        .collect();
+    let mut before = predict(fitted, &new, renderer, &config, None)?.into_iter();
     let now = predict(after, held_out, renderer, &config, None)?;
-    Ok(before
-        .into_iter()
-        .zip(now)
-        .map(|(b, a)| {
-            let c = Compared {
-                name: a.result.name,
-                params: a.result.params,
-                deviation_fit: b.result.deviation_fit,
-                deviation_after: a.result.deviation_fit,
-            };
-            (c, a.image)
-        })
-        .unzip())
+    let mut out = (Vec::new(), Vec::new());
+    for (shot, a) in held_out.iter().zip(now) {
+        let deviation_fit = match found(shot) {
+            Some(k) => k.deviation_fit,
+            None => before
+                .next()
+                .map(|b| b.result.deviation_fit)
+                .ok_or_else(|| {
+                    Error::Run(format!("held-out shot {} has no prediction", shot.name))
+                })?,
+        };
+        out.0.push(Compared {
+            name: a.result.name,
+            params: a.result.params,
+            deviation_fit,
+            deviation_after: a.result.deviation_fit,
+        });
+        out.1.push(a.image);
+    }
+    Ok(out)
 }
