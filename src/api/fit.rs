@@ -134,7 +134,7 @@ pub fn fit(
         crate::fit::set::phase::run_one(scene, &shots[0].target, renderer, &set.fit, dir, observer)
             .map(|o| Fitted::One(Box::new(o)))
     } else {
-        crate::fit::set::run_holding_out(scene, shots, renderer, &set, dir, observer)
+        crate::fit::set::run_in(scene, shots, renderer, &set, dir, observer)
             .map(|o| Fitted::Set(Box::new(o)))
     }
 }

@@ -12,7 +12,7 @@ use crate::error::{Error, Result};
 use crate::fsio::write_atomic;
 use crate::metric::Deviation;
 use crate::raster::io as image_io;
-use crate::report::html::{esc, thumb_cell, Page};
+use crate::report::html::{shot_row, Page};
 use crate::rundir;
 use std::path::Path;
 
@@ -49,7 +49,7 @@ pub fn write(
         .map(Residual::peak)
         .fold(1e-3, f64::max);
     for (i, s) in inputs.shots.iter().enumerate() {
-        let [b, a, r] = files(inputs, &s.name);
+        let [b, a, r] = files(inputs.single, &s.name);
         image_io::write_image(&before[i].heatmap(scale), &out.join(b))?;
         image_io::write_image(&after[i].heatmap(scale), &out.join(a))?;
         image_io::write_image(&model.images[i], &out.join(r))?;
@@ -72,8 +72,8 @@ pub fn write(
 
 /// A photograph's residual before, after, and render after, as named in
 /// the run directory.
-fn files(inputs: &SetInputs, name: &str) -> [String; 3] {
-    if inputs.single {
+fn files(single: bool, name: &str) -> [String; 3] {
+    if single {
         [
             rundir::RESIDUAL_BEFORE,
             rundir::RESIDUAL_AFTER,
@@ -100,15 +100,10 @@ fn set_html(d: &SetDiagnosis, scale: f64) -> Page {
     ));
     let mut grid = String::from("<table>\n<tr><th class=\"l\">shot</th><th>deviation before</th><th>after</th><th>residual before</th><th>residual after</th><th>render after</th></tr>\n");
     for s in &d.shots_after {
-        let img = |f: String| thumb_cell(&f);
-        grid.push_str(&format!(
-            "<tr><td class=\"l\">{}</td><td>{:.3}</td><td>{:.3}</td>{}{}{}</tr>\n",
-            esc(&s.name),
-            s.deviation_before.average,
-            s.deviation_after.average,
-            img(rundir::shot_residual_before(&s.name)),
-            img(rundir::shot_residual_after(&s.name)),
-            img(rundir::shot_render_after(&s.name)),
+        grid.push_str(&shot_row(
+            &s.name,
+            &[s.deviation_before.average, s.deviation_after.average],
+            &files(false, &s.name),
         ));
     }
     grid.push_str("</table>");

@@ -5,7 +5,7 @@
 //! fit's model and by the improved one (`fit::set::held_out`).
 
 use super::heatmap::{colour, shared_limit, signed_luminance};
-use super::html::{esc, thumb_cell, Page};
+use super::html::{shot_row, Page};
 use crate::error::Result;
 use crate::fit::set::held_out::Compared;
 use crate::fit::set::Shot;
@@ -49,14 +49,10 @@ pub fn section(
             &out.join(shot_residual_after(&c.name)),
         )?;
         write_image(image, &out.join(shot_render_after(&c.name)))?;
-        let img = |f: String| thumb_cell(&f);
-        table.push_str(&format!(
-            "<tr><td class=\"l\">{} (held out)</td><td>{:.3}</td><td>{:.3}</td>{}{}</tr>\n",
-            esc(&shot.name),
-            c.deviation_fit.average,
-            c.deviation_after.average,
-            img(shot_residual_after(&c.name)),
-            img(shot_render_after(&c.name)),
+        table.push_str(&shot_row(
+            &format!("{} (held out)", shot.name),
+            &[c.deviation_fit.average, c.deviation_after.average],
+            &[shot_residual_after(&c.name), shot_render_after(&c.name)],
         ));
     }
     table.push_str("</table>");

@@ -33,11 +33,25 @@ pub fn href(path: &str) -> String {
 
 /// A table cell holding a run-directory image at the grid's thumbnail
 /// width (pixels drawn square, not smoothed).
-pub fn thumb_cell(file: &str) -> String {
+fn thumb_cell(file: &str) -> String {
     format!(
         "<td><img class=\"px\" style=\"width:192px\" src=\"{}\" alt=\"\"></td>",
         href(file)
     )
+}
+
+/// A row of a photographs' grid: the photograph's label, its figures
+/// (three decimals) and its run-directory images as thumbnails.
+pub fn shot_row(label: &str, figures: &[f64], images: &[String]) -> String {
+    let mut row = format!("<tr><td class=\"l\">{}</td>", esc(label));
+    for f in figures {
+        row.push_str(&format!("<td>{f:.3}</td>"));
+    }
+    for i in images {
+        row.push_str(&thumb_cell(i));
+    }
+    row.push_str("</tr>\n");
+    row
 }
 
 const STYLE: &str = r#"

@@ -4,7 +4,7 @@
 
 use crate::math::V3;
 use crate::scene::field::{LightField, MaterialField};
-use crate::scene::{Bound, ColorSpace, Falloff, Field, FreeParam, Scene, Value};
+use crate::scene::{Bound, ColorSpace, Falloff, Field, FreeParam, Light, LightKind, Scene, Value};
 
 /// A free entry for `field` of `scene` over `min`..`max`.
 pub fn free(scene: &Scene, field: Field, min: Bound, max: Bound) -> FreeParam {
@@ -39,6 +39,16 @@ pub fn free_entry(scene: &Scene, field: Field) -> Option<&FreeParam> {
 /// True when `field` is searched.
 pub fn is_free(scene: &Scene, field: Field) -> bool {
     free_entry(scene, field).is_some()
+}
+
+/// The index of the first light of `kind` that `lacks` a field an effect
+/// adds.
+pub fn first_light(
+    scene: &Scene,
+    kind: LightKind,
+    lacks: impl Fn(&Light) -> bool,
+) -> Option<usize> {
+    (scene.lights.iter()).position(|l| l.kind == kind && lacks(l))
 }
 
 /// Indices of the objects whose specular lobe shows (set or searched).

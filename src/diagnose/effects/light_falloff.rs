@@ -1,7 +1,7 @@
 //! `light_falloff`: a point light whose irradiance falls off with another
 //! power of the distance than the scene says.
 
-use super::edit::{closer, field_of, scalar, Trades, DISTANCES};
+use super::edit::{closer, field_of, first_light, scalar, Trades, DISTANCES};
 use super::Effect;
 use crate::diagnose::features::Features;
 use crate::scene::field::LightField;
@@ -25,10 +25,7 @@ impl Effect for LightFalloff {
     /// The first point light without an exponent gets one, at the value
     /// its falloff implies.
     fn extend(&self, scene: &Scene) -> Option<(Scene, Vec<FreeParam>)> {
-        let i = scene
-            .lights
-            .iter()
-            .position(|l| l.kind == LightKind::Point && l.falloff_power.is_none())?;
+        let i = first_light(scene, LightKind::Point, |l| l.falloff_power.is_none())?;
         let mut s = scene.clone();
         let l = &mut s.lights[i];
         l.falloff_power = Some(if l.falloff == Falloff::InverseSquare {

@@ -4,7 +4,7 @@
 //! a `distance` (render/near_lights.rs), shared by every photograph of a
 //! set: a rig's lamps sit at about one distance from the object.
 
-use super::edit::{field_of, scalar, scale, Trades};
+use super::edit::{field_of, first_light, scalar, scale, Trades};
 use super::Effect;
 use crate::diagnose::features::Features;
 use crate::scene::field::LightField;
@@ -34,10 +34,7 @@ impl Effect for NearLight {
 
     /// The first directional light without a distance gets one, far away.
     fn extend(&self, scene: &Scene) -> Option<(Scene, Vec<FreeParam>)> {
-        let i = scene
-            .lights
-            .iter()
-            .position(|l| l.kind == LightKind::Directional && l.distance.is_none())?;
+        let i = first_light(scene, LightKind::Directional, |l| l.distance.is_none())?;
         let size = scale(scene);
         if size.is_nan() || size <= 0.0 {
             return None;

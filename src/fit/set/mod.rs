@@ -84,26 +84,11 @@ fn start_radii(shared: &ParamSpace, first: bool, config: &SetConfig) -> Vec<f64>
     radii
 }
 
-/// Runs a set fit of every one of `shots`, in a run directory (opened
-/// by `driver::open`) or (None) in memory only: the one fit path
-/// (`driver`) with the set's blocks.
+/// Runs a set fit of `shots`, in a run directory (opened by
+/// `driver::open`) or (None) in memory only: the one fit path (`driver`)
+/// with the set's blocks. The shots marked `hold_out` are left out of the
+/// fit and predicted after it (`held_out`); refused when every one is.
 pub fn run_in(
-    scene: &Scene,
-    shots: &[Shot],
-    renderer: &dyn Renderer,
-    config: &SetConfig,
-    dir: Option<&RunDir>,
-    observer: &mut dyn Observer,
-) -> Result<SetOutcome> {
-    let shots = (shots, &[][..]);
-    drive(
-        &Blocks, scene, shots, renderer, config, dir, false, observer,
-    )
-}
-
-/// [`run_in`] with the shots marked `hold_out` left out of the fit and
-/// predicted after it (`held_out`); refused when every one is held out.
-pub fn run_holding_out(
     scene: &Scene,
     shots: &[Shot],
     renderer: &dyn Renderer,
