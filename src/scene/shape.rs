@@ -83,6 +83,25 @@ impl Shape {
         numeric_fields!(self, std::slice::from_mut)
     }
 
+    /// Texture coordinates (u, v) of the point `p` (object frame) on the
+    /// shape, by its rule in `texture::uv`; None for a mesh (its
+    /// coordinates come from its triangles: `texture::uv::mesh_uv`).
+    pub fn uv(&self, p: V3) -> Option<[f64; 2]> {
+        use super::texture::uv;
+        let v = V3::from;
+        match *self {
+            Shape::Sphere { center, .. } => Some(uv::sphere_uv(v(center), p)),
+            Shape::Plane { point, normal } => Some(uv::plane_uv(v(point), v(normal), p)),
+            Shape::Quad {
+                corner,
+                edge_u,
+                edge_v,
+            } => Some(uv::quad_uv(v(corner), v(edge_u), v(edge_v), p)),
+            Shape::Box { min, max } => Some(uv::box_uv(v(min), v(max), p)),
+            Shape::Mesh { .. } => None,
+        }
+    }
+
     /// Refuses values the types cannot rule out (a negative radius, a
     /// zero normal), naming `file` and the key under `at`.
     pub fn check(&self, file: &str, at: &str) -> Result<()> {

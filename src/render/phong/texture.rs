@@ -242,7 +242,7 @@ fn hit_uv(
 ) -> Option<[f64; 2]> {
     let Shape::Mesh { .. } = &object.shape else {
         let p = frame.map_or(vert.p, |f| f.point(vert.p));
-        return uv::primitive_uv(&object.shape, p);
+        return object.shape.uv(p);
     };
     let at = vert.tri?;
     uv::mesh_uv(mesh?, at.tri as usize, at.u, at.v)

@@ -18,11 +18,11 @@
 //! - mesh: the file's per-vertex texture coordinates, interpolated by the
 //!   barycentric coordinates of the point in its triangle.
 //!
-//! The map's `scale` then multiplies u and v.
+//! The map's `scale` then multiplies u and v. Each shape picks its own
+//! rule in `Shape::uv` (`scene/shape.rs`), beside its other arms.
 
 use crate::math::V3;
 use crate::scene::mesh::Mesh;
-use crate::scene::shape::Shape;
 
 /// A plane's texture axes (e_u, e_v) for its normal `n` (any length).
 pub fn plane_axes(n: V3) -> (V3, V3) {
@@ -36,41 +36,35 @@ pub fn plane_axes(n: V3) -> (V3, V3) {
     (eu, n.cross(eu))
 }
 
-/// (u, v) of the point `p` (object frame) on a primitive `shape`; None
-/// for a mesh (its coordinates come from its triangles: [`mesh_uv`]).
-pub fn primitive_uv(shape: &Shape, p: V3) -> Option<[f64; 2]> {
-    match *shape {
-        Shape::Sphere { center, .. } => {
-            let d = (p - V3::from(center)).normalized();
-            let u = (-d.z).atan2(d.x) / (2.0 * std::f64::consts::PI);
-            Some([
-                u.rem_euclid(1.0),
-                0.5 + d.y.clamp(-1.0, 1.0).asin() / std::f64::consts::PI,
-            ])
-        }
-        Shape::Plane { point, normal } => {
-            let (eu, ev) = plane_axes(V3::from(normal));
-            let q = p - V3::from(point);
-            Some([q.dot(eu), q.dot(ev)])
-        }
-        Shape::Quad {
-            corner,
-            edge_u,
-            edge_v,
-        } => {
-            let (u, v) = (V3::from(edge_u), V3::from(edge_v));
-            let c = u.cross(v);
-            let w = c / c.dot(c);
-            let q = p - V3::from(corner);
-            Some([w.dot(q.cross(v)), w.dot(u.cross(q))])
-        }
-        Shape::Box { min, max } => Some(box_uv(V3::from(min), V3::from(max), p)),
-        Shape::Mesh { .. } => None,
-    }
+/// (u, v) of the point `p` on a sphere about `center`: longitude and
+/// latitude about +y.
+pub fn sphere_uv(center: V3, p: V3) -> [f64; 2] {
+    let d = (p - center).normalized();
+    let u = (-d.z).atan2(d.x) / (2.0 * std::f64::consts::PI);
+    [
+        u.rem_euclid(1.0),
+        0.5 + d.y.clamp(-1.0, 1.0).asin() / std::f64::consts::PI,
+    ]
+}
+
+/// (u, v) of the point `p` on the plane through `point` with normal `n`:
+/// metres along its axes ([`plane_axes`]).
+pub fn plane_uv(point: V3, n: V3, p: V3) -> [f64; 2] {
+    let (eu, ev) = plane_axes(n);
+    let q = p - point;
+    [q.dot(eu), q.dot(ev)]
+}
+
+/// (u, v) of the point `p` on the quad corner + s u + t v: (s, t).
+pub fn quad_uv(corner: V3, u: V3, v: V3, p: V3) -> [f64; 2] {
+    let c = u.cross(v);
+    let w = c / c.dot(c);
+    let q = p - corner;
+    [w.dot(q.cross(v)), w.dot(u.cross(q))]
 }
 
 /// A box's face nearest `p`, and (u, v) on it.
-fn box_uv(lo: V3, hi: V3, p: V3) -> [f64; 2] {
+pub fn box_uv(lo: V3, hi: V3, p: V3) -> [f64; 2] {
     let d = hi - lo;
     let f = |a: usize| (p.get(a) - lo.get(a)) / d.get(a); // 0 at min, 1 at max
     let (x, y, z) = (f(0), f(1), f(2));
@@ -113,6 +107,7 @@ pub fn mesh_uv(mesh: &Mesh, tri: usize, b1: f64, b2: f64) -> Option<[f64; 2]> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::scene::shape::Shape;
 
     fn shape(json: &str) -> Shape {
         serde_json::from_str(json).unwrap()
@@ -125,7 +120,7 @@ mod tests {
     #[test]
     fn a_quad_maps_its_corners_to_the_unit_square() {
         let q = shape(r#"{"type":"quad","corner":[1,0,0],"edge_u":[2,0,0],"edge_v":[0,0,-3]}"#);
-        let at = |x, y, z| primitive_uv(&q, V3::new(x, y, z)).unwrap();
+        let at = |x, y, z| q.uv(V3::new(x, y, z)).unwrap();
         assert!(close(at(1.0, 0.0, 0.0), [0.0, 0.0]));
         assert!(close(at(3.0, 0.0, 0.0), [1.0, 0.0]));
         assert!(close(at(2.0, 0.0, -1.5), [0.5, 0.5]));
@@ -134,17 +129,17 @@ mod tests {
     #[test]
     fn a_floor_runs_u_along_x_and_v_away_from_a_camera_on_z_and_a_wall_upright() {
         let floor = shape(r#"{"type":"plane","point":[0,0,0],"normal":[0,1,0]}"#);
-        let uv = primitive_uv(&floor, V3::new(0.5, 0.0, -2.0)).unwrap();
+        let uv = floor.uv(V3::new(0.5, 0.0, -2.0)).unwrap();
         assert!(close(uv, [0.5, 2.0]), "{uv:?}");
         let wall = shape(r#"{"type":"plane","point":[0,0,-1],"normal":[0,0,1]}"#);
-        let uv = primitive_uv(&wall, V3::new(0.5, 0.25, -1.0)).unwrap();
+        let uv = wall.uv(V3::new(0.5, 0.25, -1.0)).unwrap();
         assert!(close(uv, [0.5, 0.25]), "{uv:?}");
     }
 
     #[test]
     fn a_sphere_has_its_seam_at_plus_x_and_its_top_at_v_1() {
         let s = shape(r#"{"type":"sphere","center":[0,1,0],"radius":2}"#);
-        let at = |x, y, z| primitive_uv(&s, V3::new(x, y, z)).unwrap();
+        let at = |x, y, z| s.uv(V3::new(x, y, z)).unwrap();
         assert!(close(at(0.0, 1.0, 2.0), [0.75, 0.5])); // facing +z
         assert!(close(at(0.0, 1.0, -2.0), [0.25, 0.5]));
         assert!((at(0.0, 3.0, 0.0)[1] - 1.0).abs() < 1e-12);
@@ -153,7 +148,7 @@ mod tests {
     #[test]
     fn every_box_face_is_upright_seen_from_outside() {
         let b = shape(r#"{"type":"box","min":[0,0,0],"max":[1,2,4]}"#);
-        let at = |x, y, z| primitive_uv(&b, V3::new(x, y, z)).unwrap();
+        let at = |x, y, z| b.uv(V3::new(x, y, z)).unwrap();
         // from outside each side face, u grows to the right, v upwards
         assert!(close(at(0.25, 0.5, 4.0), [0.25, 0.25])); // +z, right is +x
         assert!(close(at(0.25, 0.5, 0.0), [0.75, 0.25])); // -z, right is -x
