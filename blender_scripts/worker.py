@@ -649,7 +649,7 @@ class Worker:
                     raise SceneError("%s: Blender read no texture coordinates from %s" % (where, file))
                 own_mesh = me
             else:
-                raise SceneError("%s: shape.type must be sphere, plane, quad or box, got %r" % (where, stype))
+                raise SceneError("%s: shape.type %r is not drawn by Blender's worker (it draws sphere, plane, quad, box and mesh)" % (where, stype))
             ob = bpy.data.objects.new(PREFIX + "obj_" + name, me)
             ob.rotation_mode = "QUATERNION"
             coll.objects.link(ob)
