@@ -83,7 +83,7 @@ Materials (per object, linked to the object's material slot)
     = (2/(shininess+2))^(1/4), Transmission = transmission, Transmission
     Roughness 0, IOR = ior; then Mix Shader (fac = reflection) with a white
     Glossy BSDF (GGX, roughness 0 = mirror).
-Texture maps (color_map, specular_map, shininess_map; docs/scene-format.md
+Texture maps (color_map, specular_map, shininess_map, normal_map; docs/scene-format.md
   "Textures", in the "phong" graph; refused on glass)
   Each map an Image Texture (Linear = bilinear between texel centres,
     Repeat) of a float image of the values scenefit decodes (decoded_image:
@@ -96,6 +96,12 @@ Texture maps (color_map, specular_map, shininess_map; docs/scene-format.md
     shininess map's red, the lobe's colour factor and roughness computed
     from them per shading point (Worker._map_graph).  Decoded images are
     kept for the worker's life.
+  normal_map: a Normal Map node (tangent space about the UV map on a
+    quad, box or mesh; object space on a plane, whose local axes are e_u,
+    e_v, n, and on a sphere, its vector turned by the sphere's east,
+    north and outward directions: Worker._sphere_frame) feeding the
+    diffuse and glossy lobes and their colour factor; the mirror keeps the
+    true normal (Worker._normal_map).
 Render
   Cycles, CPU, samples = render.samples, adaptive sampling off, denoising
   off, pixel filter BOX width 1, seed = request seed (not animated), clamping
@@ -844,6 +850,8 @@ class Worker:
             nodes["albedo_mul"] = mul
         spec = self._map_lookup(nt, uv, maps["specular_map"], "specular_map", True) if "specular_map" in maps else 1.0
         shin = self._map_lookup(nt, uv, maps["shininess_map"], "shininess_map", True) if "shininess_map" in maps else None
+        if "normal_map" in maps:
+            self._normal_map(nt, nodes, uv, maps["normal_map"], stype)
         nodes["mapped_lobes"] = []
         for j, (k, g) in enumerate(nodes["lobes"]):
             ks = _math(nt, "MULTIPLY", 0.0, spec)
@@ -853,6 +861,82 @@ class Worker:
             r = _math(nt, "POWER", _math(nt, "DIVIDE", 2.0, _math(nt, "ADD", n, 2.0)), 0.25)
             nt.links.new(r.outputs[0], g.inputs["Roughness"])
             nodes["mapped_lobes"].append((ks, n))
+
+    def _normal_map(self, nt, nodes, uv, t, stype):
+        """The normal map (tangent space, OpenGL +Y, linear) as the shading
+        normal of the diffuse and glossy lobes and of the lobes' colour
+        factor (the mirror keeps the true normal, as the built-in tracer
+        does): a Normal Map node in tangent space about the UV map (quad,
+        box, mesh); in object space for a plane (its local x, y, z are
+        e_u, e_v, n) and for a sphere, whose vector is turned here into
+        its east, north and outward directions (_sphere_frame)."""
+        N, L = nt.nodes, nt.links
+        color = self._map_lookup(nt, uv, t, "normal_map", False)
+        nm = N.new("ShaderNodeNormalMap")
+        if stype == "sphere":
+            nm.space = "OBJECT"
+            color = self._sphere_frame(nt, color)
+        elif stype == "plane":
+            nm.space = "OBJECT"
+        else:
+            nm.space = "TANGENT"  # the default (active) UV map
+        L.new(color, nm.inputs["Color"])
+        normal = nm.outputs["Normal"]
+        L.new(normal, nodes["diffuse"].inputs["Normal"])
+        for _, g in nodes["lobes"]:
+            L.new(normal, g.inputs["Normal"])
+        geo = next(n for n in N if n.bl_idname == "ShaderNodeNewGeometry")
+        for link in [lk for lk in nt.links if lk.from_socket == geo.outputs["Normal"]]:
+            L.new(normal, link.to_socket)
+
+    def _sphere_frame(self, nt, color):
+        """A tangent-space map value (colour in [0, 1]) on the sphere as
+        the object-space one: m = 2 c - 1, then m.x T + m.y B + m.z N with
+        N the unit object position, T = (-N.y, N.x, 0) normalised (east:
+        the way scenefit's u grows, Blender's local axes being the
+        scene's x, -z, y) and B = N x T (north); back to [0, 1]."""
+        N, L = nt.nodes, nt.links
+
+        def vec(op, a, b=None):
+            v = N.new("ShaderNodeVectorMath")
+            v.operation = op
+            L.new(a, v.inputs[0])
+            if b is not None:
+                L.new(b, v.inputs[1])
+            return v.outputs["Vector"]
+        tc = N.new("ShaderNodeTexCoord")
+        n = vec("NORMALIZE", tc.outputs["Object"])
+        ns = N.new("ShaderNodeSeparateXYZ")
+        L.new(n, ns.inputs[0])
+        east = N.new("ShaderNodeCombineXYZ")
+        L.new(_math(nt, "MULTIPLY", ns.outputs["Y"], -1.0).outputs[0], east.inputs[0])
+        L.new(ns.outputs["X"], east.inputs[1])
+        tv = vec("NORMALIZE", east.outputs["Vector"])
+        bv = vec("CROSS_PRODUCT", n, tv)
+        m = N.new("ShaderNodeSeparateXYZ")
+        L.new(self._affine(nt, color, 2.0, -1.0), m.inputs[0])
+        out = vec("ADD", vec("ADD", self._scaled(nt, tv, m.outputs["X"]), self._scaled(nt, bv, m.outputs["Y"])),
+                  self._scaled(nt, n, m.outputs["Z"]))
+        return self._affine(nt, out, 0.5, 0.5)
+
+    @staticmethod
+    def _affine(nt, v, a, b):
+        """The vector socket `v` times `a` plus `b` (per component)."""
+        s = nt.nodes.new("ShaderNodeVectorMath")
+        s.operation = "MULTIPLY_ADD"
+        nt.links.new(v, s.inputs[0])
+        s.inputs[1].default_value = (a, a, a)
+        s.inputs[2].default_value = (b, b, b)
+        return s.outputs["Vector"]
+
+    @staticmethod
+    def _scaled(nt, v, k):
+        """The vector socket `v` times the value socket `k`."""
+        s = nt.nodes.new("ShaderNodeVectorMath")
+        s.operation = "SCALE"
+        nt.links.new(v, s.inputs[0])
+        nt.links.new(k, s.inputs["Scale"])
+        return s.outputs["Vector"]
 
     # -- values -------------------------------------------------------------
     def apply(self, desc):

@@ -2,7 +2,9 @@
 """Writes the example textures of scenes/textured/ with the standard
 library alone (zlib; no image package): a colour map (a checker of two
 tints under a soft diagonal band, 8-bit RGB PNG, sRGB-encoded) and a
-specular map (vertical stripes of 1.0 and 0.25, 8-bit grey PNG, linear).
+specular map (vertical stripes of 1.0 and 0.25, 8-bit grey PNG, linear)
+and a normal map (bumps.png: the tangent-space normals, OpenGL +Y up,
+linear, of the height field h = 0.06 sin(2 pi u) sin(2 pi v), 8-bit RGB).
 The patterns are made by this code; nothing is downloaded.
 
     python3 scripts/make-texture.py OUT_DIR [--size N]
@@ -48,6 +50,23 @@ def specular_rows(n):
     return [[255 if (i * 6 // n) % 2 == 0 else 64 for i in range(n)] for _ in range(n)]
 
 
+def normal_rows(n, a=0.06):
+    """Texel (i, j): u = (i + 1/2)/n, v = 1 - (j + 1/2)/n (rows from the
+    top); the normal (-dh/du, -dh/dv, 1) normalised, as 255 (n + 1)/2."""
+    rows = []
+    for j in range(n):
+        row = []
+        v = 1.0 - (j + 0.5) / n
+        for i in range(n):
+            u = (i + 0.5) / n
+            hu = a * 2 * math.pi * math.cos(2 * math.pi * u) * math.sin(2 * math.pi * v)
+            hv = a * 2 * math.pi * math.sin(2 * math.pi * u) * math.cos(2 * math.pi * v)
+            k = math.sqrt(hu * hu + hv * hv + 1.0)
+            row += [int(round(255 * (c / k * 0.5 + 0.5))) for c in (-hu, -hv, 1.0)]
+        rows.append(row)
+    return rows
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("out")
@@ -56,6 +75,7 @@ def main():
     os.makedirs(a.out, exist_ok=True)
     png(os.path.join(a.out, "checker.png"), a.size, a.size, color_rows(a.size), 3)
     png(os.path.join(a.out, "stripes.png"), a.size, a.size, specular_rows(a.size), 1)
+    png(os.path.join(a.out, "bumps.png"), a.size, a.size, normal_rows(a.size), 3)
 
 
 if __name__ == "__main__":

@@ -62,6 +62,20 @@ const INPUTS: &[Input] = &[
         output: "out.png",
     },
     Input {
+        label: "render",
+        args: &["render", "sn.json", "-o", "out.png"],
+        file: "n.png",
+        kind: Kind::Image,
+        output: "out.png",
+    },
+    Input {
+        label: "render",
+        args: &["render", "se.json", "-o", "out.png"],
+        file: "n.exr",
+        kind: Kind::Exr,
+        output: "out.png",
+    },
+    Input {
         label: "fit",
         args: &["fit", "sm.json", "--target", "t.png", "-o", "out"],
         file: "m.ply",
@@ -494,7 +508,8 @@ fn set_sizes(v: &mut Value) -> bool {
 }
 
 /// The valid inputs every case starts from: a 16x12 scene, its render as
-/// target and two photographs, masks, an albedo map, a colour map, a mesh, a font, a finished
+/// target and two photographs, masks, an albedo map, a colour map, normal maps (PNG and
+/// OpenEXR), a mesh, a font, a finished
 /// fit (`run`) and a finished set fit (`setrun`).
 fn fixture() -> tempfile::TempDir {
     let d = tempfile::tempdir().unwrap();
@@ -520,6 +535,18 @@ fn fixture() -> tempfile::TempDir {
         .as_object_mut()
         .unwrap()
         .remove("color_map");
+    // normal maps, PNG and OpenEXR (tangent space: a flat texel)
+    for (key, file) in [("sn.json", "n.png"), ("se.json", "n.exr")] {
+        let mut s = scene.clone();
+        s["objects"][0]["material"]["normal_map"] = json!(file);
+        write(&p.join(key), s.to_string().as_bytes());
+    }
+    image::RgbImage::from_pixel(4, 4, image::Rgb([128, 128, 255]))
+        .save(p.join("n.png"))
+        .unwrap();
+    image::Rgb32FImage::from_pixel(4, 4, image::Rgb([0.5, 0.5, 1.0]))
+        .save(p.join("n.exr"))
+        .unwrap();
     scene["objects"][0]["shape"] = json!({"type": "mesh", "file": "m.ply"});
     write(&p.join("sm.json"), scene.to_string().as_bytes());
     std::fs::copy(scenes().join("mesh_blob.ply"), p.join("m.ply")).unwrap();

@@ -107,6 +107,12 @@ materials (d = diffuse, c = color, ks = specular, n = shininess, kr = reflection
                       mapped plane's axes are scenefit's e_u, e_v, an OBJ's v
                       is flipped back) and flips v for the bitmap's rows.
                       A map on a box or on glass is refused (render/maps.rs).
+  normal_map       -> a ``normalmap`` BSDF (its ``bitmap`` raw, as above)
+                      around ``scenefit_phong``, inside the mirror's blend:
+                      tangent space about Mitsuba's dP/du, which points as
+                      scenefit's u on every shape drawn (the mapped sphere's
+                      longitude, the plane's and quad's first axis, a
+                      mesh's u), B = N x T: the built-in tracer's frame.
   kt > 0 (glass)   -> ``principled``: base_color d*c, metallic 0,
                       roughness (2/(n+2))^(1/4), specular level min(1, ks) (F0 = 0.08*ks, so
                       ks 0.5 <-> F0 0.04, as Blender); kt > 0: spec_trans = kt and eta = ior (Mitsuba then ignores
@@ -616,8 +622,14 @@ class MitsubaBackend:
             for k in PHONG_PARAMS:
                 b[k] = m[k]
             for key, t in m["maps"].items():
-                b[key] = self.texture(t, m["uv"], key)
+                if key != "normal_map":
+                    b[key] = self.texture(t, m["uv"], key)
             b["n2_follows"] = not m["n2_own"]
+            if "normal_map" in m["maps"]:
+                # tangent space about Mitsuba's dP/du (ours: object_plan
+                # keeps u's direction); the mirror keeps the true normal
+                b = {"type": "normalmap", "bsdf": b,
+                     "normalmap": self.texture(m["maps"]["normal_map"], m["uv"], "normal_map")}
             if kind[1]:
                 b = {"type": "blendbsdf", "weight": m["mirror"], "bsdf_0": b,
                      "bsdf_1": {"type": "conductor", "material": "none"}}
@@ -671,6 +683,8 @@ class MitsubaBackend:
             if kind[1]:
                 out[prefix + ".weight.value"] = ("float", m["mirror"])
                 prefix += ".bsdf_0"
+            if "normal_map" in m["maps"]:
+                prefix += ".nested_bsdf"
             out[prefix + ".albedo"] = ("color", m["albedo"])
             for k in PHONG_PARAMS:
                 out[prefix + "." + k] = ("float", m[k])

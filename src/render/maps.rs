@@ -7,13 +7,16 @@ use super::backend::Refusal;
 use crate::scene::texture::MapKind;
 use crate::scene::Scene;
 
-/// The maps the built-in tracer draws (the normal map is not drawn yet).
-pub const PHONG: &[MapKind] = &[MapKind::Color, MapKind::Specular, MapKind::Shininess];
+/// Every map: the built-in tracer, Blender and Mitsuba draw them all.
+const ALL_MAPS: &[MapKind] = &MapKind::ALL;
+pub const PHONG: &[MapKind] = ALL_MAPS;
+pub const BLENDER: &[MapKind] = ALL_MAPS;
+pub const MITSUBA: &[MapKind] = ALL_MAPS;
 
-/// The maps POV-Ray, Blender and Mitsuba draw.
+/// The maps POV-Ray draws: not the shininess map (below), nor the normal
+/// map (its `normal { bump_map }` is a height field, and
+/// `normal { image_map }`-style tangent-space vectors it has not).
 pub const POVRAY: &[MapKind] = &[MapKind::Color, MapKind::Specular];
-pub const BLENDER: &[MapKind] = &[MapKind::Color, MapKind::Specular, MapKind::Shininess];
-pub const MITSUBA: &[MapKind] = &[MapKind::Color, MapKind::Specular, MapKind::Shininess];
 
 /// Every map refusal of the Blender worker (`mitsuba` false) or the
 /// Mitsuba worker: the maps it does not draw, and what it does not draw

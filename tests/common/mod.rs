@@ -3,6 +3,7 @@
 
 #![allow(dead_code)]
 
+pub mod bumps;
 pub mod icosphere;
 
 use std::path::{Path, PathBuf};

@@ -7,7 +7,8 @@
 //! Reads from the scene: `camera`, `image`, `ambient`, `indirect_light`,
 //! `lights` (with `radius` for soft shadows and `falloff_power`), `objects`
 //! (with `fresnel`, `specular2`, `shininess2`, `albedo_map`, and the
-//! texture maps `color_map`, `specular_map`, `shininess_map`: `texture.rs`), `render.antialias`,
+//! texture maps `color_map`, `specular_map`, `shininess_map`: `texture.rs`;
+//! `normal_map`: `normal_map.rs`), `render.antialias`,
 //! `render.max_depth`. The camera's `vignetting` and `response` are applied
 //! after any renderer (render/camera_effects.rs).
 //!
@@ -25,6 +26,7 @@ mod camera;
 mod effects;
 mod geometry;
 mod inner_ball;
+mod normal_map;
 mod packed;
 mod paths;
 mod shade;
@@ -66,9 +68,10 @@ impl Renderer for Phong {
         let cached = if moves_geometry {
             None
         } else {
-            Some(Arc::new(
-                pool.install(|| Prepared::new(base, &variation, true)),
-            ))
+            let prepared = pool
+                .install(|| Prepared::new(base, &variation, true))
+                .map_err(|e| Error::Run(e.message))?;
+            Some(Arc::new(prepared))
         };
         Ok(Box::new(PhongSession {
             pool,
@@ -85,11 +88,17 @@ struct Prepared {
 }
 
 impl Prepared {
-    fn new(scene: &Scene, variation: &Variation, parallel: bool) -> Prepared {
+    fn new(
+        scene: &Scene,
+        variation: &Variation,
+        parallel: bool,
+    ) -> std::result::Result<Prepared, RenderFailure> {
         let paths = Paths::build(scene, variation, parallel);
         // A cancelled build is empty (paths.rs): packing it costs nothing.
-        let packed = Packed::new(&paths, scene.lights.len());
-        Prepared { paths, packed }
+        let mut packed = Packed::new(&paths, scene.lights.len());
+        // a normal map is a file, never a free parameter: fixed with the hits
+        normal_map::perturb(&paths, &mut packed, scene)?;
+        Ok(Prepared { paths, packed })
     }
 }
 
@@ -123,7 +132,7 @@ impl PhongSession {
                 shade::shade(&p.paths, &p.packed, scene, &maps, tex.as_ref(), &mut buf)
             }
             None => {
-                let p = Prepared::new(scene, &self.variation, false);
+                let p = Prepared::new(scene, &self.variation, false)?;
                 // a cancelled build is cut short, never shaded
                 if cancel::is_cancelled() {
                     return Err(RenderFailure::new(cancel::MESSAGE));

@@ -21,14 +21,14 @@ use std::f64::consts::PI;
 use std::sync::Arc;
 
 /// One object's map of one kind: its texels and settings.
-struct Map {
+pub(super) struct Map {
     texels: Arc<Texels>,
     scale: [f64; 2],
     range: [f32; 2],
 }
 
 impl Map {
-    fn load(t: &TextureRef, kind: MapKind) -> Result<Map, RenderFailure> {
+    pub(super) fn load(t: &TextureRef, kind: MapKind) -> Result<Map, RenderFailure> {
         let texels = texture::get(std::path::Path::new(t.file()), t.encoding(kind))
             .map_err(|e| RenderFailure::new(format!("phong: {}: {e}", t.file())))?;
         let [lo, hi] = t.range();
@@ -40,7 +40,7 @@ impl Map {
     }
 
     /// The value at texture coordinates `uv`, RGB, after `range`.
-    fn at(&self, uv: [f64; 2]) -> [f32; 3] {
+    pub(super) fn at(&self, uv: [f64; 2]) -> [f32; 3] {
         let [lo, hi] = self.range;
         let v = self
             .texels
@@ -201,13 +201,13 @@ pub fn specular_per_hit(
 }
 
 /// World to object frame of an object with a transform.
-struct Frame {
+pub(super) struct Frame {
     rows: [V3; 3],
     t: V3,
 }
 
 impl Frame {
-    fn of(o: &Object) -> Option<Frame> {
+    pub(super) fn of(o: &Object) -> Option<Frame> {
         let a = Affine::new(o.transform.as_ref()?);
         let c = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]].map(|e| a.vector(V3::from(e)));
         let det = c[0].dot(c[1].cross(c[2]));
@@ -221,7 +221,7 @@ impl Frame {
         })
     }
 
-    fn point(&self, p: V3) -> V3 {
+    pub(super) fn point(&self, p: V3) -> V3 {
         let q = p - self.t;
         V3::new(
             self.rows[0].dot(q),
@@ -234,7 +234,7 @@ impl Frame {
 /// The texture coordinates of a hit on `object`: a primitive's from the
 /// hit point in the object's frame; a mesh's from the triangle and
 /// barycentrics the hit was found at.
-fn hit_uv(
+pub(super) fn hit_uv(
     object: &Object,
     frame: Option<&Frame>,
     mesh: Option<&Mesh>,

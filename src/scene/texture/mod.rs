@@ -14,6 +14,7 @@
 
 mod read;
 mod sample;
+pub mod tangent;
 pub mod uv;
 
 pub use read::{check, get};

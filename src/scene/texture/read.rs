@@ -133,7 +133,8 @@ pub fn check(map: &TextureRef, kind: MapKind, file: &str, key: &str) -> Result<(
         .fold((f32::INFINITY, f32::NEG_INFINITY), |(a, b), &v| {
             (a.min(v), b.max(v))
         });
-    if !(min.is_finite() && max.is_finite()) {
+    // f32::min passes over NaN: look for it apart
+    if !(min.is_finite() && max.is_finite()) || t.values.iter().any(|v| v.is_nan()) {
         return Err(bad("expected finite values".into()));
     }
     let (vmin, vmax) = (lo + min as f64 * (hi - lo), lo + max as f64 * (hi - lo));
@@ -145,6 +146,13 @@ pub fn check(map: &TextureRef, kind: MapKind, file: &str, key: &str) -> Result<(
         MapKind::Shininess if least <= 0.0 => Err(bad(format!(
             "expected exponents above 0 (after range [lo, hi]: lo + value (hi - lo)), got {least}"
         ))),
+        // a grey image (R = G = B everywhere) holds no direction: never a
+        // normal map, whose flat texel is (0.5, 0.5, 1)
+        MapKind::Normal if t.values.chunks_exact(3).all(|c| c[0] == c[1] && c[1] == c[2]) => {
+            Err(bad(
+                "a grey image (R = G = B in every texel); expected a normal map's RGB vectors (tangent space, flat = 0.5, 0.5, 1)".into(),
+            ))
+        }
         _ => Ok(()),
     }
 }

@@ -63,12 +63,24 @@ pub fn quad_uv(corner: V3, u: V3, v: V3, p: V3) -> [f64; 2] {
     [w.dot(q.cross(v)), w.dot(u.cross(q))]
 }
 
-/// A box's face nearest `p`, and (u, v) on it.
+/// (u, v) on the face of a box nearest `p`.
 pub fn box_uv(lo: V3, hi: V3, p: V3) -> [f64; 2] {
     let d = hi - lo;
     let f = |a: usize| (p.get(a) - lo.get(a)) / d.get(a); // 0 at min, 1 at max
     let (x, y, z) = (f(0), f(1), f(2));
-    // the face whose plane is nearest, in metres
+    match box_face(lo, hi, p) {
+        0 => [z, y],       // -x: u along +z
+        1 => [1.0 - z, y], // +x: u along -z
+        2 => [x, z],       // -y: v along +z
+        3 => [x, 1.0 - z], // +y: v along -z
+        4 => [1.0 - x, y], // -z: u along -x
+        _ => [x, y],       // +z
+    }
+}
+
+/// The face of a box whose plane is nearest `p`, in metres: 0 -x, 1 +x,
+/// 2 -y, 3 +y, 4 -z, 5 +z.
+pub fn box_face(lo: V3, hi: V3, p: V3) -> usize {
     let gaps = [
         (p.x - lo.x).abs(),
         (hi.x - p.x).abs(),
@@ -77,17 +89,9 @@ pub fn box_uv(lo: V3, hi: V3, p: V3) -> [f64; 2] {
         (p.z - lo.z).abs(),
         (hi.z - p.z).abs(),
     ];
-    let face = (0..6)
+    (0..6)
         .min_by(|&a, &b| gaps[a].total_cmp(&gaps[b]))
-        .unwrap_or(5);
-    match face {
-        0 => [z, y],       // -x: u along +z
-        1 => [1.0 - z, y], // +x: u along -z
-        2 => [x, z],       // -y: v along +z
-        3 => [x, 1.0 - z], // +y: v along -z
-        4 => [1.0 - x, y], // -z: u along -x
-        _ => [x, y],       // +z
-    }
+        .unwrap_or(5)
 }
 
 /// (u, v) at barycentric (b1, b2) of triangle `tri` (the file's order) of

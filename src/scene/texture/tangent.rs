@@ -1,0 +1,194 @@
+//! The tangent frame a normal map (`material.normal_map`) is read in:
+//! the surface's derivatives along its texture coordinates (dP/du,
+//! dP/dv) and its outward normal, in the object's own frame, following
+//! the parametrisations of `uv.rs` (so that every backend perturbs the
+//! same way): a plane's e_u and e_v, a quad's edges, a sphere's east and
+//! north, a box face's axes, a mesh triangle's from its corners' (u, v).
+//! On every primitive dP/du x dP/dv points outward. The map's `scale`
+//! does not enter: Blender and Mitsuba take their tangents from the
+//! surface's own coordinates too.
+
+use super::uv::{box_face, plane_axes};
+use crate::math::V3;
+use crate::scene::mesh::Mesh;
+use crate::scene::shape::Shape;
+
+/// dP/du, dP/dv (directions, any length; zero where undefined: a
+/// sphere's poles, a triangle whose (u, v) are in a line) and the
+/// outward normal (any length), object frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Tangents {
+    pub du: V3,
+    pub dv: V3,
+    pub n: V3,
+}
+
+/// The frame at `p` (object frame) on a primitive; None for a mesh
+/// ([`mesh_tangents`]).
+pub fn primitive_tangents(shape: &Shape, p: V3) -> Option<Tangents> {
+    let t = |du: V3, dv: V3, n: V3| Some(Tangents { du, dv, n });
+    match *shape {
+        Shape::Sphere { center, .. } => {
+            let d = (p - V3::from(center)).normalized();
+            // east (u grows) and north (v grows), both times cos(latitude)
+            let east = V3::new(d.z, 0.0, -d.x);
+            let north = V3::new(-d.x * d.y, 1.0 - d.y * d.y, -d.z * d.y);
+            t(east, north, d)
+        }
+        Shape::Plane { normal, .. } => {
+            let (eu, ev) = plane_axes(V3::from(normal));
+            t(eu, ev, V3::from(normal))
+        }
+        Shape::Quad { edge_u, edge_v, .. } => {
+            let (u, v) = (V3::from(edge_u), V3::from(edge_v));
+            t(u, v, u.cross(v))
+        }
+        Shape::Box { min, max } => {
+            let (x, y, z) = (
+                V3::new(1.0, 0.0, 0.0),
+                V3::new(0.0, 1.0, 0.0),
+                V3::new(0.0, 0.0, 1.0),
+            );
+            // (dP/du, dP/dv) per face, as uv.rs lays each face out
+            let (du, dv) = match box_face(V3::from(min), V3::from(max), p) {
+                0 => (z, y),
+                1 => (-z, y),
+                2 => (x, z),
+                3 => (x, -z),
+                4 => (-x, y),
+                _ => (x, y),
+            };
+            t(du, dv, du.cross(dv))
+        }
+        Shape::Mesh { .. } => None,
+    }
+}
+
+/// The frame of triangle `tri` (the file's order) of `mesh` at
+/// barycentric (b1, b2): dP/du and dP/dv solved from its corners'
+/// positions and texture coordinates (zero when those are in a line),
+/// the normal the file's per-vertex ones interpolated, else the face's
+/// by its winding. None when the file has no texture coordinates.
+pub fn mesh_tangents(mesh: &Mesh, tri: usize, b1: f64, b2: f64) -> Option<Tangents> {
+    let t = mesh.triangles.get(tri)?;
+    let uv = |k: usize| mesh.texcoords.get(t[k] as usize).copied();
+    let (t0, t1, t2) = (uv(0)?, uv(1)?, uv(2)?);
+    let p = |k: usize| mesh.positions.get(t[k] as usize).copied().map(V3::from);
+    let (p0, p1, p2) = (p(0)?, p(1)?, p(2)?);
+    let (e1, e2) = (p1 - p0, p2 - p0);
+    let (a, b) = (
+        [t1[0] - t0[0], t1[1] - t0[1]],
+        [t2[0] - t0[0], t2[1] - t0[1]],
+    );
+    let det = a[0] * b[1] - b[0] * a[1];
+    let size = (a[0].abs() + a[1].abs()) * (b[0].abs() + b[1].abs());
+    let (du, dv) = if det.abs() > 1e-12 * size && det.is_finite() {
+        ((e1 * b[1] - e2 * a[1]) / det, (e2 * a[0] - e1 * b[0]) / det)
+    } else {
+        (V3::new(0.0, 0.0, 0.0), V3::new(0.0, 0.0, 0.0))
+    };
+    let face = e1.cross(e2);
+    let normal = |k: usize| mesh.normals.get(t[k] as usize).copied().map(V3::from);
+    let n = match (normal(0), normal(1), normal(2)) {
+        (Some(n0), Some(n1), Some(n2)) => {
+            let n = n0 * (1.0 - b1 - b2) + n1 * b1 + n2 * b2;
+            if n.dot(n) > 0.0 {
+                n
+            } else {
+                face
+            }
+        }
+        _ => face,
+    };
+    Some(Tangents { du, dv, n })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn shape(json: &str) -> Shape {
+        serde_json::from_str(json).unwrap()
+    }
+
+    fn parallel(a: V3, b: V3) -> bool {
+        a.normalized().dot(b.normalized()) > 1.0 - 1e-9
+    }
+
+    /// dP/du and dP/dv are the directions in which uv.rs's coordinates
+    /// grow, checked by finite differences on each primitive, and
+    /// dP/du x dP/dv points outward.
+    #[test]
+    fn the_tangents_follow_the_texture_coordinates_and_face_out() {
+        let shapes = [
+            (
+                r#"{"type":"sphere","center":[0,1,0],"radius":2}"#,
+                V3::new(1.2, 2.0, 1.2),
+            ),
+            (
+                r#"{"type":"plane","point":[0,0,0],"normal":[0,1,0]}"#,
+                V3::new(0.3, 0.0, 0.2),
+            ),
+            (
+                r#"{"type":"plane","point":[0,0,0],"normal":[1,1,1]}"#,
+                V3::new(0.0, 0.0, 0.0),
+            ),
+            (
+                r#"{"type":"quad","corner":[1,0,0],"edge_u":[2,0,0],"edge_v":[0,0,-3]}"#,
+                V3::new(2.0, 0.0, -1.0),
+            ),
+            (
+                r#"{"type":"box","min":[0,0,0],"max":[1,2,4]}"#,
+                V3::new(0.3, 2.0, 1.0),
+            ),
+            (
+                r#"{"type":"box","min":[0,0,0],"max":[1,2,4]}"#,
+                V3::new(1.0, 0.5, 1.0),
+            ),
+            (
+                r#"{"type":"box","min":[0,0,0],"max":[1,2,4]}"#,
+                V3::new(0.5, 0.5, 0.0),
+            ),
+        ];
+        for (json, p) in shapes {
+            let s = shape(json);
+            let f = primitive_tangents(&s, p).unwrap();
+            let uv = |q: V3| super::super::uv::primitive_uv(&s, q).unwrap();
+            let h = 1e-6;
+            let (u0, du) = (uv(p), uv(p + f.du.normalized() * h));
+            assert!(
+                du[0] - u0[0] > 0.0 && (du[1] - u0[1]).abs() < 1e-9,
+                "{json}: u"
+            );
+            let dv = uv(p + f.dv.normalized() * h);
+            assert!(
+                dv[1] - u0[1] > 0.0 && (dv[0] - u0[0]).abs() < 1e-9,
+                "{json}: v"
+            );
+            assert!(parallel(f.du.cross(f.dv), f.n), "{json}: outward");
+        }
+    }
+
+    #[test]
+    fn a_mesh_triangle_solves_its_tangents_and_a_degenerate_one_has_none() {
+        let m = Mesh {
+            positions: vec![[0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [0.0, 3.0, 0.0]],
+            normals: vec![],
+            texcoords: vec![[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]],
+            triangles: vec![[0, 1, 2]],
+        };
+        let f = mesh_tangents(&m, 0, 0.2, 0.3).unwrap();
+        assert_eq!(
+            (f.du, f.dv),
+            (V3::new(2.0, 0.0, 0.0), V3::new(0.0, 3.0, 0.0))
+        );
+        assert!(parallel(f.n, V3::new(0.0, 0.0, 1.0)));
+        let flat = Mesh {
+            texcoords: vec![[0.0, 0.0], [1.0, 1.0], [2.0, 2.0]],
+            ..m
+        };
+        let f = mesh_tangents(&flat, 0, 0.2, 0.3).unwrap();
+        assert_eq!(f.du, V3::new(0.0, 0.0, 0.0));
+        assert!(f.n.z > 0.0);
+    }
+}
