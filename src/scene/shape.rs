@@ -6,6 +6,7 @@
 //! by field name through [`Shape::fields`] and [`Shape::fields_mut`].
 
 use super::checks::{finite3, nonzero3, positive};
+use super::texture::tangent::Tangents;
 use crate::error::{Error, Result};
 use crate::math::{Vec3, V3};
 use serde::{Deserialize, Serialize};
@@ -98,6 +99,21 @@ impl Shape {
                 edge_v,
             } => Some(uv::quad_uv(v(corner), v(edge_u), v(edge_v), p)),
             Shape::Box { min, max } => Some(uv::box_uv(v(min), v(max), p)),
+            Shape::Mesh { .. } => None,
+        }
+    }
+
+    /// The tangent frame a normal map is read in at the point `p` (object
+    /// frame), by the shape's rule in `texture::tangent`, following its
+    /// `uv`; None for a mesh (`texture::tangent::mesh_tangents`).
+    pub fn tangents(&self, p: V3) -> Option<Tangents> {
+        use super::texture::tangent as t;
+        let v = V3::from;
+        match *self {
+            Shape::Sphere { center, .. } => Some(t::sphere_tangents(v(center), p)),
+            Shape::Plane { normal, .. } => Some(t::plane_tangents(v(normal))),
+            Shape::Quad { edge_u, edge_v, .. } => Some(t::quad_tangents(v(edge_u), v(edge_v))),
+            Shape::Box { min, max } => Some(t::box_tangents(v(min), v(max), p)),
             Shape::Mesh { .. } => None,
         }
     }

@@ -63,7 +63,7 @@ impl Mapped {
             }
             None => {
                 let p = self.frame.as_ref().map_or(vert.p, |f| f.point(vert.p));
-                tangent::primitive_tangents(&o.shape, p)?
+                o.shape.tangents(p)?
             }
         };
         Some(match &self.affine {

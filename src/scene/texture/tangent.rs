@@ -11,7 +11,6 @@
 use super::uv::{box_face, plane_axes};
 use crate::math::V3;
 use crate::scene::mesh::Mesh;
-use crate::scene::shape::Shape;
 
 /// dP/du, dP/dv (directions, any length; zero where undefined: a
 /// sphere's poles, a triangle whose (u, v) are in a line) and the
@@ -23,44 +22,54 @@ pub struct Tangents {
     pub n: V3,
 }
 
-/// The frame at `p` (object frame) on a primitive; None for a mesh
-/// ([`mesh_tangents`]).
-pub fn primitive_tangents(shape: &Shape, p: V3) -> Option<Tangents> {
-    let t = |du: V3, dv: V3, n: V3| Some(Tangents { du, dv, n });
-    match *shape {
-        Shape::Sphere { center, .. } => {
-            let d = (p - V3::from(center)).normalized();
-            // east (u grows) and north (v grows), both times cos(latitude)
-            let east = V3::new(d.z, 0.0, -d.x);
-            let north = V3::new(-d.x * d.y, 1.0 - d.y * d.y, -d.z * d.y);
-            t(east, north, d)
-        }
-        Shape::Plane { normal, .. } => {
-            let (eu, ev) = plane_axes(V3::from(normal));
-            t(eu, ev, V3::from(normal))
-        }
-        Shape::Quad { edge_u, edge_v, .. } => {
-            let (u, v) = (V3::from(edge_u), V3::from(edge_v));
-            t(u, v, u.cross(v))
-        }
-        Shape::Box { min, max } => {
-            let (x, y, z) = (
-                V3::new(1.0, 0.0, 0.0),
-                V3::new(0.0, 1.0, 0.0),
-                V3::new(0.0, 0.0, 1.0),
-            );
-            // (dP/du, dP/dv) per face, as uv.rs lays each face out
-            let (du, dv) = match box_face(V3::from(min), V3::from(max), p) {
-                0 => (z, y),
-                1 => (-z, y),
-                2 => (x, z),
-                3 => (x, -z),
-                4 => (-x, y),
-                _ => (x, y),
-            };
-            t(du, dv, du.cross(dv))
-        }
-        Shape::Mesh { .. } => None,
+/// The frame at `p` on a sphere about `center`: east (u grows) and north
+/// (v grows), both times cos(latitude), and the outward direction.
+pub fn sphere_tangents(center: V3, p: V3) -> Tangents {
+    let d = (p - center).normalized();
+    let east = V3::new(d.z, 0.0, -d.x);
+    let north = V3::new(-d.x * d.y, 1.0 - d.y * d.y, -d.z * d.y);
+    Tangents {
+        du: east,
+        dv: north,
+        n: d,
+    }
+}
+
+/// The frame of the plane with normal `n`: its texture axes.
+pub fn plane_tangents(n: V3) -> Tangents {
+    let (du, dv) = plane_axes(n);
+    Tangents { du, dv, n }
+}
+
+/// The frame of the quad with edges `u`, `v`.
+pub fn quad_tangents(u: V3, v: V3) -> Tangents {
+    Tangents {
+        du: u,
+        dv: v,
+        n: u.cross(v),
+    }
+}
+
+/// The frame at `p` on a box between `lo` and `hi`: its nearest face's
+/// axes, as `uv.rs` lays each face out.
+pub fn box_tangents(lo: V3, hi: V3, p: V3) -> Tangents {
+    let (x, y, z) = (
+        V3::new(1.0, 0.0, 0.0),
+        V3::new(0.0, 1.0, 0.0),
+        V3::new(0.0, 0.0, 1.0),
+    );
+    let (du, dv) = match box_face(lo, hi, p) {
+        0 => (z, y),
+        1 => (-z, y),
+        2 => (x, z),
+        3 => (x, -z),
+        4 => (-x, y),
+        _ => (x, y),
+    };
+    Tangents {
+        du,
+        dv,
+        n: du.cross(dv),
     }
 }
 
@@ -106,6 +115,7 @@ pub fn mesh_tangents(mesh: &Mesh, tri: usize, b1: f64, b2: f64) -> Option<Tangen
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::scene::shape::Shape;
 
     fn shape(json: &str) -> Shape {
         serde_json::from_str(json).unwrap()
@@ -152,8 +162,8 @@ mod tests {
         ];
         for (json, p) in shapes {
             let s = shape(json);
-            let f = primitive_tangents(&s, p).unwrap();
-            let uv = |q: V3| super::super::uv::primitive_uv(&s, q).unwrap();
+            let f = s.tangents(p).unwrap();
+            let uv = |q: V3| s.uv(q).unwrap();
             let h = 1e-6;
             let (u0, du) = (uv(p), uv(p + f.du.normalized() * h));
             assert!(
