@@ -14,12 +14,14 @@ use std::time::Instant;
 
 /// What the loop evaluates: a batch of unit-cube points, in order.
 pub trait Problem {
-    /// Evaluates `points`; residual vectors only when `residuals` is set.
-    /// `generation` (counted over the whole run) seeds sampling renderers.
+    /// Evaluates `points`; residual vectors only when `residuals` is
+    /// `Some(blur)`, of target and render blurred alike by a Gaussian of
+    /// `blur` pixels (0: as rendered; see `metric::blur`). `generation`
+    /// (counted over the whole run) seeds sampling renderers.
     fn evaluate(
         &mut self,
         points: &[Vec<f64>],
-        residuals: bool,
+        residuals: Option<f64>,
         generation: usize,
     ) -> Vec<Evaluation>;
     /// Why each of the last batch's failed evaluations failed.
@@ -105,7 +107,8 @@ impl Executor<'_> {
             let started = Instant::now();
             let request = search.ask();
             let generation = offsets.generations + search.generation();
-            let evaluations = problem.evaluate(&request.points, request.residuals, generation);
+            let view = request.residuals.then_some(request.blur);
+            let evaluations = problem.evaluate(&request.points, view, generation);
             // A batch cut short by an interrupt is not told: the search
             // stays as the checkpoint has it, and a resume redoes it.
             if self.interrupted() {

@@ -6,7 +6,7 @@
 
 use super::executor::Problem;
 use super::FitTarget;
-use crate::metric::{deviation, residuals, Deviation};
+use crate::metric::{blurred_levels, blurred_residuals, deviation, residuals, Deviation};
 use crate::optimize::Evaluation;
 use crate::raster::Image;
 use crate::render::RenderSession;
@@ -26,6 +26,9 @@ pub struct ShotsProblem<'a> {
     best: Option<(f64, Vec<Image>)>,
     failures: Vec<String>,
     failed_renders: usize,
+    /// Each target's blurred levels at the blur last asked for (a local
+    /// search asks for one blur over many batches).
+    blurred: Option<(u64, Vec<Vec<f32>>)>,
 }
 
 impl<'a> ShotsProblem<'a> {
@@ -46,6 +49,7 @@ impl<'a> ShotsProblem<'a> {
             best: None,
             failures: Vec::new(),
             failed_renders: 0,
+            blurred: None,
         }
     }
 
@@ -87,12 +91,49 @@ impl<'a> ShotsProblem<'a> {
         Evaluation::failed()
     }
 
+    /// Every target's levels blurred by `sigma` pixels, computed once per
+    /// blur.
+    fn blurred_targets(&mut self, sigma: f64) -> &[Vec<f32>] {
+        if self
+            .blurred
+            .as_ref()
+            .is_none_or(|(s, _)| *s != sigma.to_bits())
+        {
+            let levels = self
+                .targets
+                .iter()
+                .map(|t| blurred_levels(&t.image, t.mask.as_ref(), sigma))
+                .collect();
+            self.blurred = Some((sigma.to_bits(), levels));
+        }
+        self.blurred.as_ref().map_or(&[], |(_, v)| v)
+    }
+
+    /// One photograph's residuals at the view asked for (see
+    /// `Problem::evaluate`).
+    fn residuals_of(&mut self, shot: usize, img: &Image, blur: f64) -> Vec<f32> {
+        let t = self.targets[shot];
+        if blur > 0.0 {
+            let target = &self.blurred_targets(blur)[shot];
+            blurred_residuals(target, img, t.mask.as_ref(), blur)
+        } else {
+            residuals(&t.image, img, t.mask.as_ref())
+        }
+    }
+
     /// Scores one candidate's images (one per photograph): the deviation
     /// over every counted pixel of every photograph, as one fitness.
-    fn score(&mut self, i: usize, generation: usize, images: Vec<Image>, want: bool) -> Evaluation {
+    fn score(
+        &mut self,
+        i: usize,
+        generation: usize,
+        images: Vec<Image>,
+        want: Option<f64>,
+    ) -> Evaluation {
         let mut res = Vec::new();
         let mut parts = Vec::with_capacity(images.len());
-        for (img, t) in images.iter().zip(&self.targets) {
+        for (shot, img) in images.iter().enumerate() {
+            let t = self.targets[shot];
             if img.dimensions() != t.image.dimensions() {
                 let why = format!(
                     "image is {}x{}, expected {}x{}",
@@ -104,8 +145,8 @@ impl<'a> ShotsProblem<'a> {
                 return self.fail(i, generation, why);
             }
             parts.push((deviation(&t.image, img, t.mask.as_ref()), counted(t)));
-            if want {
-                res.extend(residuals(&t.image, img, t.mask.as_ref()));
+            if let Some(blur) = want {
+                res.extend(self.residuals_of(shot, img, blur));
             }
         }
         let fitness = over(&parts).fitness();
@@ -114,7 +155,7 @@ impl<'a> ShotsProblem<'a> {
         }
         Evaluation {
             fitness,
-            residuals: want.then_some(res),
+            residuals: want.map(|_| res),
         }
     }
 }
@@ -138,7 +179,12 @@ pub fn counted(t: &FitTarget) -> usize {
 }
 
 impl Problem for ShotsProblem<'_> {
-    fn evaluate(&mut self, points: &[Vec<f64>], want: bool, generation: usize) -> Vec<Evaluation> {
+    fn evaluate(
+        &mut self,
+        points: &[Vec<f64>],
+        want: Option<f64>,
+        generation: usize,
+    ) -> Vec<Evaluation> {
         self.failures.clear();
         let n = self.bases.len();
         let scenes: Vec<Scene> = points.iter().flat_map(|u| self.scenes_at(u)).collect();

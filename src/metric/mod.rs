@@ -8,8 +8,10 @@
 //! float, linear) also has a precise deviation, [`deviation_levels`]: the
 //! same formula on its unrounded levels.
 
+pub mod blur;
 pub mod mask;
 
+pub use blur::{blurred_levels, blurred_residuals};
 pub use mask::Mask;
 
 use crate::raster::Image;

@@ -34,7 +34,10 @@
 //! from the change they produce (`lm::adapt_step`), since the images are
 //! 8-bit, and carry over from one local run to the next. A periodic
 //! coordinate (a hue, [`Hybrid::set_periods`]) steps round its circle
-//! instead of stopping at a face (`lm::wrap`).
+//! instead of stopping at a face (`lm::wrap`). When a run finds its
+//! sharp difference columns to be noise (edges that move in sample
+//! steps), it descends blurred residuals first (`pyramid.rs`), and every
+//! later run starts coarse.
 //!
 //! **Back to the global phase.** A local run ends when its last few steps
 //! lowered the log fitness per render less than the global phase did over
@@ -90,7 +93,7 @@ use super::basins::{alike, Basins};
 use super::identifiability::Identifiability;
 use super::lm::Normal;
 use super::local::Local;
-use super::{exact, De, DeConfig, Evaluation, Progress, Request, Search, Strategy};
+use super::{exact, pyramid, De, DeConfig, Evaluation, Progress, Request, Search, Strategy};
 
 /// Hand over when the largest per-coordinate spread is below
 /// [`HANDOVER_SPREAD`], or when this quantile of them is below
@@ -188,6 +191,10 @@ pub struct Hybrid {
     /// Local runs of earlier populations.
     #[serde(default)]
     earlier_local_runs: usize,
+    /// Whether a local run found the sharp difference columns to be noise:
+    /// every later run then starts coarse (`pyramid.rs`).
+    #[serde(default)]
+    rough: bool,
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -288,6 +295,7 @@ impl Hybrid {
             basins: Basins::default(),
             population_ends: Vec::new(),
             earlier_local_runs: 0,
+            rough: false,
         }
     }
 
@@ -450,6 +458,7 @@ impl Hybrid {
             rate,
             global_done,
             &self.periods,
+            if self.rough { pyramid::BLUR_START } else { 0.0 },
         ));
         self.starts.push(start);
     }
@@ -487,9 +496,11 @@ impl Hybrid {
         }
         let going = local.tell(evaluations);
         // The normal equations belong to the run's point only after a
-        // Jacobian batch.
+        // Jacobian batch, and say how well the fit is determined only
+        // when sharp.
+        let sharp = local.blur == 0.0;
         if let (Some(normal), None) = (&local.normal, &trial) {
-            if self.observe(&local.x, local.fitness) || local.x == self.best {
+            if (self.observe(&local.x, local.fitness) || local.x == self.best) && sharp {
                 self.at_best = Some(normal.clone());
             }
         }
@@ -498,6 +509,7 @@ impl Hybrid {
             return;
         }
         self.steps = local.steps.clone();
+        self.rough |= local.rough;
         if local.fitness < self.local_end * (1.0 - SETTLED_GAIN) {
             self.fresh_tries = 0;
         }
@@ -581,12 +593,14 @@ impl Search for Hybrid {
             Phase::Local(local) => Request {
                 points: local.batch().to_vec(),
                 residuals: true,
+                blur: local.blur,
             },
             // Nothing left to try; an executor that asks anyway gets the
             // best point again, which changes nothing.
             Phase::Done => Request {
                 points: vec![self.best.clone()],
                 residuals: false,
+                blur: 0.0,
             },
         }
     }

@@ -319,6 +319,16 @@ pub fn adapt_step(step: f64, center: &[f32], perturbed: Option<&[f32]>) -> f64 {
     change.next_step(step)
 }
 
+/// Whether a coordinate's difference step is as the step rule wants it
+/// (its mean change at least the band's low end, or the step at
+/// [`STEP_MAX`]): only then does a column's noise say something about
+/// the image rather than about a step still too short.
+pub fn resolved(step: f64, center: &[f32], perturbed: Option<&[f32]>) -> bool {
+    let mut change = Change::default();
+    change.add(center, perturbed);
+    !change.failed && (step >= STEP_MAX || change.mean() >= CHANGE_LOW)
+}
+
 /// What one coordinate's difference changed, summed over one or more
 /// residual vectors (a set's coordinate changes several photographs), for
 /// [`Change::next_step`].
@@ -346,17 +356,22 @@ impl Change {
         }
     }
 
+    /// The mean absolute change over the values that changed.
+    fn mean(&self) -> f64 {
+        if self.changed == 0 {
+            0.0
+        } else {
+            self.total / self.changed as f64
+        }
+    }
+
     /// The next step after `step` (see [`adapt_step`]).
     pub fn next_step(&self, step: f64) -> f64 {
         if self.failed {
             // A failed render near a point: try closer next time.
             return (step * 0.5).clamp(STEP_MIN, STEP_MAX);
         }
-        let mean = if self.changed == 0 {
-            0.0
-        } else {
-            self.total / self.changed as f64
-        };
+        let mean = self.mean();
         let next = if mean < CHANGE_LOW {
             step * 4.0
         } else if mean > CHANGE_HIGH {

@@ -21,6 +21,15 @@
 //! shortens a step spans many orders of magnitude, and a fixed factor from
 //! a small λ gives back the same trial, paid for with another render.
 //!
+//! **Coarse to fine** (`pyramid.rs`). When a sharp Jacobian's columns
+//! are noise, the run goes on at [`pyramid::BLUR_START`] pixels of blur:
+//! its Jacobians, trials and acceptance all use the residuals of blurred
+//! images (the sharp fitness is still what the hybrid keeps as the best).
+//! What would end a run at a blurred level instead halves the blur and
+//! asks for a Jacobian at the same point, down to the sharp level, where
+//! the run ends as below. The difference steps are held while blurred:
+//! the rule that steers them (`lm::adapt_step`) counts 8-bit levels.
+//!
 //! **End.** After [`STALL_STEPS`] steps in a row without a relative gain
 //! of [`GAIN_TOLERANCE`] (rejected trials count), when the damping passes
 //! [`LAMBDA_MAX`], or when the last [`RATE_WINDOW`] steps lowered the log
@@ -29,7 +38,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::lm::{self, Column, Normal};
-use super::{exact, Evaluation};
+use super::{exact, pyramid, Evaluation};
 
 /// Local steps over which the local rate of progress is measured.
 pub const RATE_WINDOW: usize = 3;
@@ -104,15 +113,35 @@ pub struct Local {
     /// `lm::wrap`; empty: none is periodic).
     #[serde(with = "exact::vector", default)]
     periods: Vec<f64>,
+    /// The blur of the residuals the run minimises now, in pixels (0:
+    /// sharp; see the module docs).
+    #[serde(with = "exact::scalar", default)]
+    pub blur: f64,
+    /// The blurred merit of the accepted point while `blur` > 0
+    /// (`pyramid::merit`); at the sharp level the fitness is the merit.
+    #[serde(with = "exact::scalar", default = "unknown")]
+    blurred_merit: f64,
+    /// Set once the run found its sharp columns to be noise (it then went
+    /// coarse, and does not again).
+    #[serde(default)]
+    pub rough: bool,
+}
+
+/// A merit not yet measured.
+fn unknown() -> f64 {
+    f64::INFINITY
 }
 
 impl Local {
+    /// A run from `x`; `blur` > 0 starts it coarse (a landscape already
+    /// known to be rough), at that level.
     pub fn start(
         x: &[f64],
         steps: Vec<f64>,
         rate_floor: f64,
         global_done: bool,
         periods: &[f64],
+        blur: f64,
     ) -> Local {
         // The same image, farther from the faces (see `lm::wrap`).
         let x = lm::wrap(x, periods);
@@ -134,6 +163,28 @@ impl Local {
             outpaced: false,
             global_done,
             periods: periods.to_vec(),
+            blur,
+            blurred_merit: f64::INFINITY,
+            rough: blur > 0.0,
+        }
+    }
+
+    /// What the run minimises at its level, for one evaluation: the
+    /// fitness when sharp, the blurred residuals' merit otherwise.
+    fn merit_of(&self, evaluation: &Evaluation) -> f64 {
+        if self.blur > 0.0 {
+            pyramid::merit(evaluation.residuals.as_deref())
+        } else {
+            evaluation.fitness
+        }
+    }
+
+    /// The accepted point's merit at the run's level.
+    fn merit(&self) -> f64 {
+        if self.blur > 0.0 {
+            self.blurred_merit
+        } else {
+            self.fitness
         }
     }
 
@@ -165,8 +216,16 @@ impl Local {
     pub fn tell(&mut self, evaluations: &[Evaluation]) -> bool {
         self.renders += evaluations.len();
         match self.probe {
-            Probe::Jacobian => self.tell_jacobian(evaluations) && self.next_trial(),
-            Probe::Trial => self.tell_trial(evaluations[0].fitness),
+            Probe::Jacobian => {
+                if !self.tell_jacobian(evaluations) {
+                    return false;
+                }
+                if self.coarsen(evaluations) {
+                    return true;
+                }
+                self.next_trial()
+            }
+            Probe::Trial => self.tell_trial(&evaluations[0]),
         }
     }
 
@@ -195,9 +254,12 @@ impl Local {
             })
             .collect();
         let normal = lm::normal_equations(r, &columns);
-        for (j, step) in self.steps.iter_mut().enumerate() {
-            *step = lm::adapt_step(*step, r, evaluations[j + 1].residuals.as_deref());
+        if self.blur == 0.0 {
+            for (j, step) in self.steps.iter_mut().enumerate() {
+                *step = lm::adapt_step(*step, r, evaluations[j + 1].residuals.as_deref());
+            }
         }
+        self.blurred_merit = pyramid::merit(Some(r));
         let fitness = if centre.fitness.is_finite() {
             centre.fitness
         } else {
@@ -216,15 +278,16 @@ impl Local {
 
     /// Accepts or rejects the trial; an accepted one's Jacobian is asked
     /// for next.
-    fn tell_trial(&mut self, fitness: f64) -> bool {
-        if fitness == 0.0 && self.fitness > 0.0 {
+    fn tell_trial(&mut self, evaluation: &Evaluation) -> bool {
+        if evaluation.fitness == 0.0 && self.fitness > 0.0 {
             // Nothing is left to gain: no Jacobian is worth its renders.
             self.x = self.batch[0].clone();
             self.fitness = 0.0;
             return false;
         }
-        if fitness < self.fitness {
-            let gain = (self.fitness - fitness) / self.fitness;
+        let (merit, current) = (self.merit_of(evaluation), self.merit());
+        if merit < current {
+            let gain = (current - merit) / current;
             self.stalled = if gain > GAIN_TOLERANCE {
                 0
             } else {
@@ -261,32 +324,91 @@ impl Local {
         self.next_trial()
     }
 
-    /// Appends the accepted fitness after a step to the history.
+    /// Appends the accepted merit after a step to the history.
     fn record(&mut self) {
-        self.history.push((self.fitness.to_bits(), self.renders));
+        self.history.push((self.merit().to_bits(), self.renders));
         if self.history.len() > RATE_WINDOW + 1 {
             self.history.remove(0);
         }
     }
 
-    /// The next trial, unless the run has ended (see the module docs).
+    /// The next trial, unless the run has ended (see the module docs); a
+    /// blurred level that would end goes on at the next level instead.
     fn next_trial(&mut self) -> bool {
-        if self.fitness == 0.0 || self.stalled >= STALL_STEPS || self.lambda > LAMBDA_MAX {
+        if self.fitness == 0.0 {
             return false;
+        }
+        match self.propose() {
+            Some(trial) => {
+                self.batch = vec![trial];
+                self.probe = Probe::Trial;
+                true
+            }
+            None if self.blur > 0.0 => {
+                self.set_level(pyramid::next_level(self.blur));
+                true
+            }
+            None => false,
+        }
+    }
+
+    /// The damped step's trial at this level, or None when the level has
+    /// ended (see the module docs).
+    fn propose(&mut self) -> Option<Vec<f64>> {
+        if self.merit() == 0.0 || self.stalled >= STALL_STEPS || self.lambda > LAMBDA_MAX {
+            return None;
         }
         if self.slower_than_global() {
-            self.outpaced = true;
+            // Only the sharp level's pace is the run's.
+            self.outpaced = self.blur == 0.0;
+            return None;
+        }
+        let normal = self.normal.as_ref()?;
+        let trial = lm::bounded_trial(normal, self.lambda, &self.x, &self.periods)?;
+        self.predicted = lm::predicted_gain(normal, &self.x, &trial, &self.periods);
+        Some(trial)
+    }
+
+    /// Goes on at blur `blur` from the accepted point: a fresh Jacobian
+    /// there, the damping and the stall count as at a start.
+    fn set_level(&mut self, blur: f64) {
+        self.blur = blur;
+        self.blurred_merit = f64::INFINITY;
+        self.stalled = 0;
+        self.lambda = LAMBDA_START;
+        self.history.clear();
+        self.batch = neighbourhood(&self.x, &self.steps);
+        self.probe = Probe::Jacobian;
+    }
+
+    /// After a sharp Jacobian: when its resolved columns are noise
+    /// (`pyramid::rough`) and the run has not been coarse yet, it goes to
+    /// the coarsest level; returns whether it did.
+    fn coarsen(&mut self, evaluations: &[Evaluation]) -> bool {
+        if self.blur > 0.0 || self.rough {
             return false;
         }
-        let Some(normal) = &self.normal else {
+        let Some(r) = evaluations[0].residuals.as_deref() else {
             return false;
         };
-        let Some(trial) = lm::bounded_trial(normal, self.lambda, &self.x, &self.periods) else {
+        let p = self.x.len();
+        let agreements: Vec<f64> = (0..p)
+            .filter_map(|j| {
+                let a = evaluations[1 + j].residuals.as_deref()?;
+                let b = evaluations[1 + p + j].residuals.as_deref()?;
+                let s = self.batch[1 + j][j] - self.batch[0][j];
+                let t = self.batch[1 + p + j][j] - self.batch[0][j];
+                if !lm::resolved(s.abs(), r, Some(a)) {
+                    return None;
+                }
+                pyramid::agreement(r, (a, s), (b, t))
+            })
+            .collect();
+        if !pyramid::rough(&agreements) {
             return false;
-        };
-        self.predicted = lm::predicted_gain(normal, &self.x, &trial, &self.periods);
-        self.batch = vec![trial];
-        self.probe = Probe::Trial;
+        }
+        self.rough = true;
+        self.set_level(pyramid::BLUR_START);
         true
     }
 

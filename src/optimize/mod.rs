@@ -42,6 +42,7 @@ pub mod lm;
 mod local;
 mod operators;
 mod progress;
+mod pyramid;
 mod rand1bin;
 mod sampling;
 mod search;

@@ -14,6 +14,12 @@ pub struct Request {
     pub points: Vec<Vec<f64>>,
     /// Whether each point's residual vector is needed, not just its fitness.
     pub residuals: bool,
+    /// The view the residuals are wanted at: target and render each
+    /// blurred by a Gaussian of this many pixels before they are
+    /// subtracted (0: as rendered). The fitness is always the sharp one.
+    /// The search names a scale, never an image: the metric applies it
+    /// (`metric::blur`), so the search still knows nothing of images.
+    pub blur: f64,
 }
 
 /// How one point scored. A failed render has an infinite fitness and no
@@ -21,7 +27,8 @@ pub struct Request {
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Evaluation {
     pub fitness: f64,
-    /// Per-value residuals (render − target, over the mask), when asked for.
+    /// Per-value residuals (render − target, over the mask, at the blur
+    /// asked for), when asked for.
     pub residuals: Option<Vec<f32>>,
 }
 
@@ -68,6 +75,7 @@ impl Search for De {
         Request {
             points: De::ask(self),
             residuals: false,
+            blur: 0.0,
         }
     }
 
