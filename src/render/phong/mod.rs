@@ -24,6 +24,7 @@ mod bvh_node;
 mod camera;
 mod effects;
 mod geometry;
+mod hull_faces;
 mod inner_ball;
 mod packed;
 mod paths;

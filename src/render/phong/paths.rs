@@ -262,7 +262,7 @@ impl Tracer<'_> {
             tri: hit.tri,
         });
         for l in 0..self.scene.lights.len() {
-            let s = self.classify(p, n, face, hit.object, l);
+            let s = self.classify(p, n, face, (hit.object, hit.tri), l);
             self.shadow.push(s);
         }
         self.budget = self.budget.saturating_sub(1);
@@ -303,8 +303,15 @@ impl Tracer<'_> {
     }
 
     /// Which primitives could shadow point `p` (normal `n`, face normal
-    /// `face`, on `object`) from light `l`.
-    fn classify(&mut self, p: V3, n: V3, face: V3, object: u32, l: usize) -> Shadow {
+    /// `face`, on `object`, at mesh triangle `tri` if any) from light `l`.
+    fn classify(
+        &mut self,
+        p: V3,
+        n: V3,
+        face: V3,
+        (object, tri): (u32, Option<TriPoint>),
+        l: usize,
+    ) -> Shadow {
         let light = &self.scene.lights[l];
         let g = self.geometry;
         let others = |i: &usize| g.may_shadow(*i, object);
@@ -323,7 +330,7 @@ impl Tracer<'_> {
         if let Some((d, dist)) = fixed {
             // A light that does not move: decide once.
             let o = p + n * EPS * 10.0;
-            let lit = n.dot(d) > 0.0 && !g.blocked_by_others(o, d, dist, object);
+            let lit = n.dot(d) > 0.0 && !g.blocked_by_others(o, d, dist, object, tri);
             return if lit { Shadow::Lit } else { Shadow::Dark };
         }
         let bounds = match self.var.lights[l] {
