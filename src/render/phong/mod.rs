@@ -26,6 +26,7 @@ mod effects;
 mod geometry;
 mod hull_faces;
 mod inner_ball;
+pub mod measure;
 mod packed;
 mod paths;
 mod shade;

@@ -68,19 +68,7 @@ pub struct TriMesh {
 impl TriMesh {
     pub fn new(m: &Mesh) -> TriMesh {
         let p = |i: u32| V3::from(m.positions[i as usize]);
-        let boxes: Vec<Aabb> = m
-            .triangles
-            .iter()
-            .map(|t| {
-                let b = Aabb {
-                    lo: p(t[0]),
-                    hi: p(t[0]),
-                };
-                let b = Aabb::hull(p(t[1]), b.lo, b.hi);
-                Aabb::hull(p(t[2]), b.lo, b.hi)
-            })
-            .collect();
-        let bvh = Bvh::build(&boxes);
+        let bvh = Bvh::build(&boxes(m));
         let tri = |t: &[u32; 3]| Tri {
             v0: p(t[0]),
             e1: p(t[1]) - p(t[0]),
@@ -122,6 +110,11 @@ impl TriMesh {
         let bounds = (t.bounds.lo, t.bounds.hi);
         t.ball = inner_ball::find(&m.positions, &m.triangles, bounds, |o, d| t.crossings(o, d));
         t
+    }
+
+    /// True when the mesh is closed and holds an inner ball.
+    pub fn has_inner_ball(&self) -> bool {
+        self.ball.is_some()
     }
 
     /// The number of triangles the ray o + t d meets (t > EPS).
@@ -225,6 +218,22 @@ impl TriMesh {
         self.bvh
             .any(o, d, t_max, |k| self.tris[k].hit(o, d, t_max).is_some())
     }
+}
+
+/// Each triangle's bounding box, as numbered in the file.
+pub fn boxes(m: &Mesh) -> Vec<Aabb> {
+    let p = |i: u32| V3::from(m.positions[i as usize]);
+    m.triangles
+        .iter()
+        .map(|t| {
+            let b = Aabb {
+                lo: p(t[0]),
+                hi: p(t[0]),
+            };
+            let b = Aabb::hull(p(t[1]), b.lo, b.hi);
+            Aabb::hull(p(t[2]), b.lo, b.hi)
+        })
+        .collect()
 }
 
 type Cache = Mutex<HashMap<String, Arc<TriMesh>>>;
