@@ -5,11 +5,15 @@
 //! intensity; camera hits traced once, shadow rays per candidate), (b)
 //! the floor free and (c) the ball's pose free (yaw and position; in both
 //! every camera and shadow ray is traced per candidate). Then, timed once:
-//! reading a 1,310,720-triangle mesh, a session on two threads (which
-//! builds its BVH) and a render. Each timed case also prints its renders
-//! per CPU second (both threads' time summed), which a shared machine's
-//! load changes far less than the wall-clock rate. `cargo bench --bench
-//! mesh`; figures in docs/benchmarks.md.
+//! reading a 1,310,720-triangle mesh, building its BVH alone and its
+//! whole traced structure (BVH and inner ball) on two threads, a session
+//! on two threads (which builds them) and a render. Each timed case also
+//! prints its renders per CPU second (both threads' time summed), which a
+//! shared machine's load changes far less than the wall-clock rate, and,
+//! where every ray is traced per candidate, the rays a render traces
+//! (counted: camera, reflected, and one shadow ray per hit facing the
+//! light, however it is answered) and so the rays per second. `cargo
+//! bench --bench mesh`; figures in docs/benchmarks.md.
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use rand::{Rng, SeedableRng};
@@ -65,7 +69,7 @@ fn scene(shape: serde_json::Value, free: serde_json::Value) -> Scene {
     parse(&v.to_string(), "bench scene", &[]).expect("bench scene is valid")
 }
 
-fn generation(base: &Scene) -> (Box<dyn RenderSession>, Vec<Scene>) {
+fn generation(base: &Scene) -> (Box<dyn RenderSession>, Vec<Scene>, ParamSpace) {
     let space = ParamSpace::from_scene(base);
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
     let scenes: Vec<Scene> = (0..80)
@@ -79,7 +83,7 @@ fn generation(base: &Scene) -> (Box<dyn RenderSession>, Vec<Scene>) {
         .unwrap()
         .session(base, &space, jobs)
         .unwrap();
-    (session, scenes)
+    (session, scenes, space)
 }
 
 fn bench(c: &mut Criterion) {
@@ -115,7 +119,7 @@ fn bench(c: &mut Criterion) {
         ("pose_free", &pose),
     ] {
         for (name, shape) in &shapes {
-            let (mut session, scenes) = generation(&scene(shape.clone(), free.clone()));
+            let (mut session, scenes, space) = generation(&scene(shape.clone(), free.clone()));
             group.bench_function(format!("{what}/{name}"), |b| {
                 b.iter(|| session.render_batch(&scenes, 0))
             });
@@ -127,14 +131,38 @@ fn bench(c: &mut Criterion) {
                 session.render_batch(&scenes, 0);
                 n += 1;
             }
-            eprintln!(
-                "{what}/{name}: {:.0} renders per CPU second",
-                (n * scenes.len()) as f64 / (cpu() - c)
-            );
+            let renders = (n * scenes.len()) as f64;
+            let (wall, per_cpu) = (renders / t.elapsed().as_secs_f64(), renders / (cpu() - c));
+            eprintln!("{what}/{name}: {per_cpu:.0} renders per CPU second");
+            if what != "light_free" {
+                rays(&format!("{what}/{name}"), &scenes, &space, wall, per_cpu);
+            }
         }
     }
     group.finish();
     big_mesh(dir.path());
+}
+
+/// The rays a render of each of `scenes` traces, counted, and so the rays
+/// per second at `wall` renders per second and `per_cpu` per CPU second.
+fn rays(what: &str, scenes: &[Scene], space: &ParamSpace, wall: f64, per_cpu: f64) {
+    let mut all = scenefit::render::phong::measure::Rays::default();
+    for s in scenes {
+        let r = scenefit::render::phong::measure::rays_traced(s, space);
+        all.camera += r.camera;
+        all.secondary += r.secondary;
+        all.shadow += r.shadow;
+    }
+    let n = scenes.len() as f64;
+    let per_render = (all.camera + all.secondary + all.shadow) as f64 / n;
+    eprintln!(
+        "{what}: {per_render:.0} rays per render ({:.0} camera, {:.0} reflected or refracted, {:.0} shadow); {:.2} M rays/s ({wall:.0} renders/s over the CPU-rate loop), {:.2} M rays per CPU second",
+        all.camera as f64 / n,
+        all.secondary as f64 / n,
+        all.shadow as f64 / n,
+        per_render * wall * 1e-6,
+        per_render * per_cpu * 1e-6
+    );
 }
 
 /// Reading, checking and building the BVH of 1.3 M triangles, once.
@@ -142,8 +170,9 @@ fn big_mesh(dir: &Path) {
     let p = dir.join("ico8.ply");
     icosphere(&p, 8, [0.0, 0.5, 0.0], 0.5);
     let t = std::time::Instant::now();
-    scenefit::scene::mesh::read(&p).unwrap();
+    let mesh = scenefit::scene::mesh::read(&p).unwrap();
     let read = t.elapsed();
+    build_alone(&mesh);
     // the scene reads the file (once per process) ...
     let big = scene(
         serde_json::json!({"type": "mesh", "file": p}),
@@ -165,6 +194,41 @@ fn big_mesh(dir: &Path) {
     eprintln!(
         "1310720 triangles: file read and checked in {read:.2?}; session on 2 threads (BVH built, camera rays traced) {build:.2?} wall, {build_cpu:.2} s CPU; a render {:.2?}",
         t.elapsed()
+    );
+}
+
+/// The traced structure of `mesh` built alone on two threads, three
+/// times each: the BVH, then everything (BVH, triangles in its order,
+/// inner ball); medians of wall and CPU time, and per million triangles.
+fn build_alone(mesh: &scenefit::scene::mesh::Mesh) {
+    use scenefit::render::phong::measure;
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(2)
+        .build()
+        .unwrap();
+    let m = mesh.triangles.len() as f64 * 1e-6;
+    let time = |f: &(dyn Fn() + Sync)| {
+        let mut runs: Vec<(f64, f64)> = (0..3)
+            .map(|_| {
+                let (t, c) = (std::time::Instant::now(), cpu());
+                pool.install(f);
+                (t.elapsed().as_secs_f64(), cpu() - c)
+            })
+            .collect();
+        runs.sort_by(|a, b| a.0.total_cmp(&b.0));
+        runs[1]
+    };
+    let bvh = time(&|| assert_eq!(measure::build_bvh(mesh), mesh.triangles.len()));
+    let all = time(&|| assert!(measure::build_mesh(mesh), "the icosphere is closed"));
+    eprintln!(
+        "{} triangles built alone on 2 threads (median of 3): BVH {:.3} s wall, {:.3} s CPU; BVH and inner ball {:.3} s wall, {:.3} s CPU; per million triangles {:.3} s wall, {:.3} s CPU",
+        mesh.triangles.len(),
+        bvh.0,
+        bvh.1,
+        all.0,
+        all.1,
+        all.0 / m,
+        all.1 / m
     );
 }
 

@@ -208,10 +208,31 @@ impl Geometry {
     }
 
     /// True when a primitive that may shadow `object` lies on the
-    /// segment from `o` along `d` within (EPS, t_max).
-    pub fn blocked_by_others(&self, o: V3, d: V3, t_max: f64, object: u32) -> bool {
-        self.accel
-            .any(&self.prims, o, d, t_max, |i| self.may_shadow(i, object))
+    /// segment from `o` along `d` within (EPS, t_max). `from`: the mesh
+    /// triangle the segment starts just off, if any; a segment leaving a
+    /// face of the mesh's convex hull outwards is not tested against that
+    /// mesh (`hull_faces.rs`).
+    pub fn blocked_by_others(
+        &self,
+        o: V3,
+        d: V3,
+        t_max: f64,
+        object: u32,
+        from: Option<TriPoint>,
+    ) -> bool {
+        self.accel.any(&self.prims, o, d, t_max, |i| {
+            self.may_shadow(i, object) && !self.leaves_own_hull(i, object, from, o, d)
+        })
+    }
+
+    /// True when primitive `i` is the mesh of `object` and the ray from
+    /// `o` along `d` leaves its triangle `from` outwards through a hull face.
+    #[inline]
+    fn leaves_own_hull(&self, i: usize, object: u32, from: Option<TriPoint>, o: V3, d: V3) -> bool {
+        match (&self.prims[i], from) {
+            (Prim::Mesh(m), Some(at)) if self.owner[i] == object => m.leaves_outward(at.tri, o, d),
+            _ => false,
+        }
     }
 
     /// Whether primitive `i` may shadow a point of `object`: a convex
@@ -645,7 +666,10 @@ mod tests {
             let hits = agree(&a, &b, transform, |o, d, hb, i| {
                 // from the far side of the hit, back through the mesh: it shadows itself
                 let p = o + d * (hb.t + 1e-3);
-                assert!(b.blocked_by_others(p, -d, 1.0, 0), "{transform}: ray {i}");
+                assert!(
+                    b.blocked_by_others(p, -d, 1.0, 0, None),
+                    "{transform}: ray {i}"
+                );
             });
             assert!(hits > 50, "{transform}: {hits} hits");
         }

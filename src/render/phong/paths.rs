@@ -58,6 +58,29 @@ pub struct Paths {
     pub shadow: Vec<Shadow>,
     pub occluders: Vec<Occluder>,
     pub geometry: Geometry,
+    /// The rays traced to build these paths.
+    pub rays: Rays,
+}
+
+/// Rays traced while the paths were built, counted as a tracer without
+/// shortcuts would cast them: camera rays, the reflected and refracted
+/// rays they spawn, and one shadow ray per hit and fixed light that faces
+/// the hit (however it was answered: a sphere test, a hull face, a walk).
+/// Shadow rays towards a moving light are cast when a candidate is shaded
+/// and are not counted here.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Rays {
+    pub camera: u64,
+    pub secondary: u64,
+    pub shadow: u64,
+}
+
+impl Rays {
+    fn add(&mut self, o: Rays) {
+        self.camera += o.camera;
+        self.secondary += o.secondary;
+        self.shadow += o.shadow;
+    }
 }
 
 /// What may change about each light between candidates.
@@ -138,6 +161,7 @@ impl Paths {
                 shadow: Vec::new(),
                 occluders: Vec::new(),
                 budget: 0,
+                rays: Rays::default(),
             };
             // cut short on Ctrl-C: every render then fails (mod.rs)
             for y in rows.take_while(|_| !crate::exec::cancel::is_cancelled()) {
@@ -147,6 +171,7 @@ impl Paths {
                             let fx = x as f64 + (sx as f64 + 0.5) / aa as f64;
                             let fy = y as f64 + (sy as f64 + 0.5) / aa as f64;
                             let (o, d) = cam.ray(fx, fy);
+                            t.rays.camera += 1;
                             let Some(hit) = geometry.intersect_camera_ray(o, d, (fx, fy), &rects)
                             else {
                                 continue;
@@ -157,9 +182,9 @@ impl Paths {
                     }
                 }
             }
-            (t.verts, t.shadow, t.occluders)
+            (t.verts, t.shadow, t.occluders, t.rays)
         };
-        let parts: Vec<(Vec<Vertex>, Vec<Shadow>, Vec<Occluder>)> = if parallel {
+        let parts: Vec<Part> = if parallel {
             (0..h)
                 .into_par_iter()
                 .map(|y| trace_rows(y..y + 1))
@@ -175,6 +200,7 @@ impl Paths {
             shadow: Vec::new(),
             occluders: Vec::new(),
             geometry,
+            rays: Rays::default(),
         };
         paths.join(parts);
         paths
@@ -186,9 +212,10 @@ impl Paths {
     /// between them. Cut short on Ctrl-C: on a large image the joining
     /// and the packing after it take seconds, and what is left of a
     /// cancelled build is never drawn (mod.rs), so it is left empty.
-    fn join(&mut self, parts: Vec<(Vec<Vertex>, Vec<Shadow>, Vec<Occluder>)>) {
+    fn join(&mut self, parts: Vec<Part>) {
         let cancelled = crate::exec::cancel::is_cancelled;
-        for (verts, shadow, occluders) in parts {
+        for (verts, shadow, occluders, rays) in parts {
+            self.rays.add(rays);
             if cancelled() {
                 self.verts.clear();
                 self.shadow.clear();
@@ -215,6 +242,9 @@ impl Paths {
     }
 }
 
+/// What a run of rows traced: hits, their shadowing, occluders, rays.
+type Part = (Vec<Vertex>, Vec<Shadow>, Vec<Occluder>, Rays);
+
 struct Tracer<'a> {
     scene: &'a Scene,
     geometry: &'a Geometry,
@@ -224,6 +254,7 @@ struct Tracer<'a> {
     occluders: Vec<Occluder>,
     /// Hits the current camera ray may still add.
     budget: u32,
+    rays: Rays,
 }
 
 /// Hits one camera ray's tree may hold. An object that both reflects and
@@ -234,6 +265,7 @@ const MAX_VERTICES_PER_RAY: u32 = 256;
 
 impl Tracer<'_> {
     fn trace(&mut self, pixel: u32, o: V3, d: V3, parent: u32, via: Via, depth: u32) {
+        self.rays.secondary += 1;
         if let Some(hit) = self.geometry.intersect(o, d, f64::INFINITY) {
             self.record(pixel, o, d, hit, parent, via, depth);
         }
@@ -262,7 +294,7 @@ impl Tracer<'_> {
             tri: hit.tri,
         });
         for l in 0..self.scene.lights.len() {
-            let s = self.classify(p, n, face, hit.object, l);
+            let s = self.classify(p, n, face, (hit.object, hit.tri), l);
             self.shadow.push(s);
         }
         self.budget = self.budget.saturating_sub(1);
@@ -303,8 +335,15 @@ impl Tracer<'_> {
     }
 
     /// Which primitives could shadow point `p` (normal `n`, face normal
-    /// `face`, on `object`) from light `l`.
-    fn classify(&mut self, p: V3, n: V3, face: V3, object: u32, l: usize) -> Shadow {
+    /// `face`, on `object`, at mesh triangle `tri` if any) from light `l`.
+    fn classify(
+        &mut self,
+        p: V3,
+        n: V3,
+        face: V3,
+        (object, tri): (u32, Option<TriPoint>),
+        l: usize,
+    ) -> Shadow {
         let light = &self.scene.lights[l];
         let g = self.geometry;
         let others = |i: &usize| g.may_shadow(*i, object);
@@ -323,7 +362,9 @@ impl Tracer<'_> {
         if let Some((d, dist)) = fixed {
             // A light that does not move: decide once.
             let o = p + n * EPS * 10.0;
-            let lit = n.dot(d) > 0.0 && !g.blocked_by_others(o, d, dist, object);
+            let faces = n.dot(d) > 0.0;
+            self.rays.shadow += faces as u64;
+            let lit = faces && !g.blocked_by_others(o, d, dist, object, tri);
             return if lit { Shadow::Lit } else { Shadow::Dark };
         }
         let bounds = match self.var.lights[l] {
@@ -425,6 +466,34 @@ mod tests {
             }
             assert!(hits > 0);
         }
+    }
+
+    /// The rays counted are the rays cast: in a scene with a floor (every
+    /// pixel's ray meets something) and fixed lights, one camera ray per
+    /// pixel and sample, and one shadow ray per hit and light facing it;
+    /// in the same order or in parallel rows alike.
+    #[test]
+    fn the_rays_counted_are_the_rays_cast() {
+        let mut scene = example("sphere_floor.json");
+        scene.render.antialias = 2;
+        let var = Variation::new(&scene, &ParamSpace::default());
+        let paths = Paths::build(&scene, &var, false);
+        let (w, h) = (scene.image.width as u64, scene.image.height as u64);
+        assert_eq!(paths.rays.camera, w * h * 4);
+        let facing: usize = paths
+            .verts
+            .iter()
+            .map(|v| {
+                let facing = |l: &crate::scene::Light| match l.kind {
+                    LightKind::Point => (V3::from(l.position.unwrap()) - v.p).dot(v.n) > 0.0,
+                    LightKind::Directional => V3::from(l.direction.unwrap()).dot(v.n) > 0.0,
+                };
+                scene.lights.iter().filter(|l| facing(l)).count()
+            })
+            .sum();
+        assert!(facing > 0);
+        assert_eq!(paths.rays.shadow, facing as u64);
+        assert_eq!(paths.rays, Paths::build(&scene, &var, true).rays);
     }
 
     /// The sequential build (one per candidate) and the parallel one (once

@@ -6,6 +6,7 @@
 
 use super::accel::{Aabb, FaceHit, TriPoint, EPS};
 use super::bvh::Bvh;
+use super::hull_faces::HullFaces;
 use super::inner_ball::{self, Ball};
 use crate::math::V3;
 use crate::scene::mesh::{self, Mesh};
@@ -58,24 +59,16 @@ pub struct TriMesh {
     sphere: (V3, f64),
     /// For a closed mesh, a ball inside it (`inner_ball.rs`).
     ball: Option<Ball>,
+    /// Which triangles lie on the convex hull (`hull_faces.rs`).
+    hull: HullFaces,
+    /// The BVH position of each triangle as numbered in the file.
+    position: Vec<u32>,
 }
 
 impl TriMesh {
     pub fn new(m: &Mesh) -> TriMesh {
         let p = |i: u32| V3::from(m.positions[i as usize]);
-        let boxes: Vec<Aabb> = m
-            .triangles
-            .iter()
-            .map(|t| {
-                let b = Aabb {
-                    lo: p(t[0]),
-                    hi: p(t[0]),
-                };
-                let b = Aabb::hull(p(t[1]), b.lo, b.hi);
-                Aabb::hull(p(t[2]), b.lo, b.hi)
-            })
-            .collect();
-        let bvh = Bvh::build(&boxes);
+        let bvh = Bvh::build(&boxes(m));
         let tri = |t: &[u32; 3]| Tri {
             v0: p(t[0]),
             e1: p(t[1]) - p(t[0]),
@@ -97,7 +90,13 @@ impl TriMesh {
             .iter()
             .map(|&v| (V3::from(v) - centre).length())
             .fold(0.0, f64::max);
+        let mut position = vec![0u32; bvh.order.len()];
+        for (k, &i) in bvh.order.iter().enumerate() {
+            position[i as usize] = k as u32;
+        }
         let mut t = TriMesh {
+            hull: HullFaces::new(bvh.order.len(), centre, radius),
+            position,
             tris,
             normals,
             bvh,
@@ -111,6 +110,11 @@ impl TriMesh {
         let bounds = (t.bounds.lo, t.bounds.hi);
         t.ball = inner_ball::find(&m.positions, &m.triangles, bounds, |o, d| t.crossings(o, d));
         t
+    }
+
+    /// True when the mesh is closed and holds an inner ball.
+    pub fn has_inner_ball(&self) -> bool {
+        self.ball.is_some()
     }
 
     /// The number of triangles the ray o + t d meets (t > EPS).
@@ -151,6 +155,21 @@ impl TriMesh {
                     .any(|v| v.dot(m) > thr)
             },
         )
+    }
+
+    /// True when the ray from `o` along `d` (a point on triangle `tri`,
+    /// numbered as in the file, and just off it) leaves the mesh outwards
+    /// through a face on its convex hull, and so meets no triangle
+    /// (`hull_faces.rs`).
+    #[inline]
+    pub fn leaves_outward(&self, tri: u32, o: V3, d: V3) -> bool {
+        let Some(&k) = self.position.get(tri as usize) else {
+            return false;
+        };
+        let t = &self.tris[k as usize];
+        let plane = (t.v0, t.e1.cross(t.e2));
+        self.hull
+            .leaves(k as usize, plane, o, d, |m, thr| self.reaches_above(m, thr))
     }
 
     /// The nearest hit: distance, the shading normal (not unit): the
@@ -201,6 +220,22 @@ impl TriMesh {
     }
 }
 
+/// Each triangle's bounding box, as numbered in the file.
+pub fn boxes(m: &Mesh) -> Vec<Aabb> {
+    let p = |i: u32| V3::from(m.positions[i as usize]);
+    m.triangles
+        .iter()
+        .map(|t| {
+            let b = Aabb {
+                lo: p(t[0]),
+                hi: p(t[0]),
+            };
+            let b = Aabb::hull(p(t[1]), b.lo, b.hi);
+            Aabb::hull(p(t[2]), b.lo, b.hi)
+        })
+        .collect()
+}
+
 type Cache = Mutex<HashMap<String, Arc<TriMesh>>>;
 
 /// The traced form of the mesh file `path`, built once per process.
@@ -226,6 +261,9 @@ pub struct Placed {
     pub mesh: Arc<TriMesh>,
     place: Place,
     pub bounds: Aabb,
+    /// A world sphere holding the placed mesh, grown far beyond rounding
+    /// error: centre and squared radius (`may_meet`).
+    reach: (V3, f64),
 }
 
 #[derive(Debug)]
@@ -284,11 +322,39 @@ impl Placed {
                 })
             }
         };
-        Placed {
+        let mut placed = Placed {
             mesh,
             place,
             bounds,
+            reach: (V3::new(0.0, 0.0, 0.0), 0.0),
+        };
+        let (c, r) = placed.sphere();
+        let r = r * (1.0 + 1e-6) + 1e-9 * (1.0 + c.length());
+        placed.reach = (c, r * r);
+        placed
+    }
+
+    /// False when the ray o + t d certainly meets no triangle within
+    /// (0, t_max): it misses the grown bounding sphere there. Asked
+    /// before the ray is carried into the mesh's frame, so that the many
+    /// rays that pass a small mesh by cost one sphere test. A ray that
+    /// starts a million radii away is not ruled out: its transformed
+    /// start may be rounded by more than the sphere was grown.
+    #[inline(always)]
+    fn may_meet(&self, o: V3, d: V3, t_max: f64) -> bool {
+        let (c, r2) = self.reach;
+        let oc = o - c;
+        let (a, b, cc) = (d.dot(d), oc.dot(d), oc.dot(oc));
+        if cc > 1e12 * r2 {
+            return true;
         }
+        let disc = b * b - a * (cc - r2);
+        if disc < 0.0 {
+            return false;
+        }
+        // the roots are (-b -+ sq) / a, a > 0
+        let sq = disc.sqrt();
+        -b + sq >= 0.0 && -b - sq <= t_max * a
     }
 
     /// The ray in the mesh's frame; `None` when there is nothing to hit.
@@ -305,6 +371,9 @@ impl Placed {
     /// and where on the mesh.
     #[inline]
     pub fn hit(&self, o: V3, d: V3, t_max: f64) -> Option<FaceHit> {
+        if !self.may_meet(o, d, t_max) {
+            return None;
+        }
         let (ol, dl) = self.local(o, d)?;
         let (t, n, ng, at) = self.mesh.hit(ol, dl, t_max)?;
         let (n, ng) = match &self.place {
@@ -355,8 +424,19 @@ impl Placed {
 
     #[inline]
     pub fn any(&self, o: V3, d: V3, t_max: f64) -> bool {
+        self.may_meet(o, d, t_max)
+            && self
+                .local(o, d)
+                .is_some_and(|(ol, dl)| self.mesh.any(ol, dl, t_max))
+    }
+
+    /// True when the ray from `o` along `d`, which starts just off
+    /// triangle `tri` of this mesh, leaves it outwards through a face on
+    /// its convex hull: it then meets none of the mesh's triangles.
+    #[inline]
+    pub fn leaves_outward(&self, tri: u32, o: V3, d: V3) -> bool {
         self.local(o, d)
-            .is_some_and(|(ol, dl)| self.mesh.any(ol, dl, t_max))
+            .is_some_and(|(ol, dl)| self.mesh.leaves_outward(tri, ol, dl))
     }
 }
 
@@ -425,5 +505,48 @@ mod tests {
             }
         }
         assert!(short > 500, "{short}");
+    }
+
+    /// Two boxes side by side (one mesh, not convex): a shadow ray that
+    /// the hull test rules out, from just off any triangle in any
+    /// direction, meets no triangle on the walk; the test rules out many
+    /// rays, and none from the faces that look at the other box.
+    #[test]
+    fn a_ray_leaving_a_hull_face_meets_nothing() {
+        let mut m = cube();
+        let n = m.positions.len() as u32;
+        let far: Vec<[f64; 3]> = m
+            .positions
+            .iter()
+            .map(|p| [p[0] + 3.0, p[1], p[2]])
+            .collect();
+        m.positions.extend(far);
+        let more: Vec<[u32; 3]> = m.triangles.iter().map(|t| t.map(|i| i + n)).collect();
+        m.triangles.extend(more);
+        let t = TriMesh::new(&m);
+        let (mut clear, mut facing) = (0, 0);
+        for (i, tri) in m.triangles.iter().enumerate() {
+            let [a, b, c] = tri.map(|k| V3::from(m.positions[k as usize]));
+            // away from the box's centre, whichever way the triangle winds
+            let centre = V3::new(if i < 12 { 0.0 } else { 3.0 }, 0.0, 0.0);
+            let out = (b - a).cross(c - a).normalized();
+            let out = if out.dot(a - centre) < 0.0 { -out } else { out };
+            for (w, off) in [(0.2, 1e-6), (0.45, 1e-6), (0.3, -1e-6)] {
+                let p = a * (1.0 - 2.0 * w) + b * w + c * w + out * off;
+                for k in 0..100 {
+                    let z = 1.0 - (k as f64 + 0.5) / 50.0;
+                    let r = (1.0 - z * z).sqrt();
+                    let d = V3::new(r * (k as f64 * 2.4).cos(), z, r * (k as f64 * 2.4).sin());
+                    if t.leaves_outward(i as u32, p, d) {
+                        assert!(!t.any(p, d, 1e9), "triangle {i} {p:?} {d:?}");
+                        clear += 1;
+                        // the first box's +x faces look at the second box
+                        facing += (i < 12 && out.x > 0.5) as usize;
+                    }
+                }
+            }
+        }
+        assert!(clear > 2000, "{clear}");
+        assert_eq!(facing, 0);
     }
 }
