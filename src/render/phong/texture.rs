@@ -201,13 +201,13 @@ pub fn specular_per_hit(
 }
 
 /// World to object frame of an object with a transform.
-struct Frame {
+pub(super) struct Frame {
     rows: [V3; 3],
     t: V3,
 }
 
 impl Frame {
-    fn of(o: &Object) -> Option<Frame> {
+    pub(super) fn of(o: &Object) -> Option<Frame> {
         let a = Affine::new(o.transform.as_ref()?);
         let c = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]].map(|e| a.vector(V3::from(e)));
         let det = c[0].dot(c[1].cross(c[2]));
@@ -234,7 +234,7 @@ impl Frame {
 /// The texture coordinates of a hit on `object`: a primitive's from the
 /// hit point in the object's frame; a mesh's from the triangle and
 /// barycentrics the hit was found at.
-fn hit_uv(
+pub(super) fn hit_uv(
     object: &Object,
     frame: Option<&Frame>,
     mesh: Option<&Mesh>,
