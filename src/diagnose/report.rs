@@ -32,7 +32,8 @@ pub fn write(
 ) -> Result<()> {
     let (before, after) = residuals;
     write_atomic(&out.join(rundir::DIAGNOSIS_JSON), json(d)?.as_bytes())?;
-    write_atomic(&out.join(rundir::IMPROVED_SCENE), json(scene)?.as_bytes())?;
+    let scene = super::map_file::beside(scene, out);
+    write_atomic(&out.join(rundir::IMPROVED_SCENE), json(&scene)?.as_bytes())?;
     let scale = before.peak().max(after.peak()).max(1e-3);
     image_io::write_image(&before.heatmap(scale), &out.join(rundir::RESIDUAL_BEFORE))?;
     image_io::write_image(&after.heatmap(scale), &out.join(rundir::RESIDUAL_AFTER))?;
@@ -52,10 +53,8 @@ pub fn write_set(
 ) -> Result<()> {
     let (before, after) = residuals;
     write_atomic(&out.join(rundir::DIAGNOSIS_JSON), json(d)?.as_bytes())?;
-    write_atomic(
-        &out.join(rundir::IMPROVED_SCENE),
-        json(&model.scene)?.as_bytes(),
-    )?;
+    let scene = super::map_file::beside(&model.scene, out);
+    write_atomic(&out.join(rundir::IMPROVED_SCENE), json(&scene)?.as_bytes())?;
     let scale = before
         .iter()
         .chain(after)
