@@ -14,6 +14,7 @@
 //! values solved, ln N each. The maps are written into the diagnosis
 //! directory as 16-bit linear PNG (`map_file.rs`).
 
+use super::effects::covered;
 use super::inputs::Params;
 use super::model::{shots_of, Model};
 use super::refits::Refits;
@@ -27,23 +28,6 @@ use crate::render::surface_coords;
 use crate::scene::texture::TextureRef;
 use crate::scene::Scene;
 use std::path::{Path, PathBuf};
-
-/// The objects the map covers: those with a diffuse colour for it to
-/// multiply and no map of their own (a colour texture, or a map in the
-/// image's frame).
-pub(super) fn covered(scene: &Scene) -> Vec<bool> {
-    scene
-        .objects
-        .iter()
-        .map(|o| {
-            let m = &o.material;
-            m.diffuse > 0.0
-                && m.color != [0.0; 3]
-                && m.color_map.is_none()
-                && m.albedo_map.is_none()
-        })
-        .collect()
-}
 
 /// `scene` with each `(object, map)` set as that object's colour map.
 fn with_maps(scene: &Scene, maps: &[(usize, TextureRef)]) -> Scene {

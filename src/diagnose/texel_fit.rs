@@ -16,7 +16,46 @@
 //! in order: deterministic). A value is then kept only when the SAD of
 //! the samples in its cell falls by more than `cost`.
 
-use super::texels::{Levels, Sample};
+use crate::render::camera_effects;
+use crate::scene::Response;
+
+/// The camera between the linear values the renderer shades and the
+/// 8-bit levels of the file, as the image-space pass writes them
+/// (`render/camera_effects.rs`): the curve `black + gain v^gamma`, then
+/// the sRGB encoding or, for a response whose `encoding` is `linear`, the
+/// level as it is. Without a declared response, the sRGB encoding alone.
+pub struct Levels {
+    response: Response,
+    /// Each level's linear value, the curve undone.
+    pub linear: Vec<f64>,
+}
+
+impl Levels {
+    pub fn new(response: Option<Response>) -> Levels {
+        let response = response.unwrap_or_default();
+        let linear = (0..=255u8)
+            .map(|v| camera_effects::linear(&response, v))
+            .collect();
+        Levels { response, linear }
+    }
+
+    /// The level written for the linear value `x`.
+    pub fn level(&self, x: f64) -> u8 {
+        camera_effects::level(&self.response, x)
+    }
+}
+
+/// One counted pixel seeing a laid-out object: the photograph, the four
+/// texels its lookup blends and their weights, the texel whose cell holds
+/// it, and per channel the target, lit and dark levels.
+#[derive(Clone, Copy, Debug)]
+pub struct Sample {
+    pub photo: u16,
+    pub texels: [u32; 4],
+    pub weights: [f32; 4],
+    pub nearest: u32,
+    pub levels: [[u8; 3]; 3],
+}
 
 /// Multipliers are clamped to this (a pixel lit far less than the model
 /// says, e.g. a shadow the model misses, is not a map).

@@ -19,11 +19,10 @@
 //! sees a covered object, 16 bytes more for the texels' lists, besides
 //! the maps (`texel_layout.rs` caps their side).
 
-use super::texel_fit::{fit_channel, Fitted};
+use super::texel_fit::{fit_channel, Fitted, Levels, Sample};
 use super::texel_layout::Layout;
 use crate::metric::Mask;
 use crate::raster::Image;
-use crate::render::camera_effects;
 use crate::render::SurfaceCoords;
 use crate::scene::Response;
 
@@ -58,44 +57,6 @@ pub struct ObjectMap {
     pub layout: Layout,
     pub values: Vec<f32>,
     pub count: usize,
-}
-
-/// The camera between the linear values the renderer shades and the
-/// 8-bit levels of the file, as the image-space pass writes them
-/// (`render/camera_effects.rs`): the curve `black + gain v^gamma`, then
-/// the sRGB encoding or, for a response whose `encoding` is `linear`, the
-/// level as it is. Without a declared response, the sRGB encoding alone.
-pub struct Levels {
-    response: Response,
-    /// Each level's linear value, the curve undone.
-    pub linear: Vec<f64>,
-}
-
-impl Levels {
-    pub fn new(response: Option<Response>) -> Levels {
-        let response = response.unwrap_or_default();
-        let linear = (0..=255u8)
-            .map(|v| camera_effects::linear(&response, v))
-            .collect();
-        Levels { response, linear }
-    }
-
-    /// The level written for the linear value `x`.
-    pub fn level(&self, x: f64) -> u8 {
-        camera_effects::level(&self.response, x)
-    }
-}
-
-/// One counted pixel seeing a laid-out object: the photograph, the four
-/// texels its lookup blends and their weights, the texel whose cell holds
-/// it, and per channel the target, lit and dark levels.
-#[derive(Clone, Copy, Debug)]
-pub struct Sample {
-    pub photo: u16,
-    pub texels: [u32; 4],
-    pub weights: [f32; 4],
-    pub nearest: u32,
-    pub levels: [[u8; 3]; 3],
 }
 
 /// Per laid-out object, its samples in photograph and pixel order; and

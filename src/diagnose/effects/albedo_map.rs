@@ -21,9 +21,9 @@ impl Effect for AlbedoMap {
     }
 
     /// Applies while some object has a diffuse colour for it to multiply
-    /// and no map of its own (`albedo::covered`).
+    /// and no map of its own (`covered`).
     fn extend(&self, scene: &Scene) -> Option<(Scene, Vec<FreeParam>)> {
-        if !crate::diagnose::albedo::covered(scene).contains(&true) {
+        if !covered(scene).contains(&true) {
             return None;
         }
         Some((scene.clone(), Vec::new()))
@@ -32,4 +32,21 @@ impl Effect for AlbedoMap {
     fn closed_form(&self) -> bool {
         true
     }
+}
+
+/// The objects the map covers: those with a diffuse colour for it to
+/// multiply and no map of their own (a colour texture, or a map in the
+/// image's frame).
+pub(crate) fn covered(scene: &Scene) -> Vec<bool> {
+    scene
+        .objects
+        .iter()
+        .map(|o| {
+            let m = &o.material;
+            m.diffuse > 0.0
+                && m.color != [0.0; 3]
+                && m.color_map.is_none()
+                && m.albedo_map.is_none()
+        })
+        .collect()
 }
