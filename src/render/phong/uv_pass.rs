@@ -9,11 +9,9 @@
 use super::camera::CameraRays;
 use super::geometry::Geometry;
 use super::paths::{Vertex, Via, NO_PARENT};
-use super::texture::{hit_uv, Frame};
-use crate::scene::mesh::{self, Mesh};
-use crate::scene::{Scene, Shape};
+use super::texture::{hit_uv, object_meshes, Frame};
+use crate::scene::Scene;
 use rayon::prelude::*;
-use std::sync::Arc;
 
 /// What one pixel sees: an object and its texture coordinates there.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -44,14 +42,7 @@ pub fn surface_coords(scene: &Scene) -> SurfaceCoords {
     let (w, h) = (scene.image.width, scene.image.height);
     let aa = scene.render.antialias.max(1);
     let frames: Vec<Option<Frame>> = scene.objects.iter().map(Frame::of).collect();
-    let meshes: Vec<Option<Arc<Mesh>>> = scene
-        .objects
-        .iter()
-        .map(|o| match &o.shape {
-            Shape::Mesh { file } => mesh::get(std::path::Path::new(file)).ok(),
-            _ => None,
-        })
-        .collect();
+    let meshes = object_meshes(scene);
     let object_at = |fx: f64, fy: f64| {
         let (o, d) = cam.ray(fx, fy);
         geometry

@@ -130,6 +130,7 @@ mod tests {
     /// dP/du x dP/dv points outward.
     #[test]
     fn the_tangents_follow_the_texture_coordinates_and_face_out() {
+        let b = r#"{"type":"box","min":[0,0,0],"max":[1,2,4]}"#;
         let shapes = [
             (
                 r#"{"type":"sphere","center":[0,1,0],"radius":2}"#,
@@ -147,18 +148,9 @@ mod tests {
                 r#"{"type":"quad","corner":[1,0,0],"edge_u":[2,0,0],"edge_v":[0,0,-3]}"#,
                 V3::new(2.0, 0.0, -1.0),
             ),
-            (
-                r#"{"type":"box","min":[0,0,0],"max":[1,2,4]}"#,
-                V3::new(0.3, 2.0, 1.0),
-            ),
-            (
-                r#"{"type":"box","min":[0,0,0],"max":[1,2,4]}"#,
-                V3::new(1.0, 0.5, 1.0),
-            ),
-            (
-                r#"{"type":"box","min":[0,0,0],"max":[1,2,4]}"#,
-                V3::new(0.5, 0.5, 0.0),
-            ),
+            (b, V3::new(0.3, 2.0, 1.0)),
+            (b, V3::new(1.0, 0.5, 1.0)),
+            (b, V3::new(0.5, 0.5, 0.0)),
         ];
         for (json, p) in shapes {
             let s = shape(json);
