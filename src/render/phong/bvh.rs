@@ -18,10 +18,15 @@ use super::accel::Aabb;
 use super::bvh_build::{self, Item, SAH_DEPTH};
 use super::bvh_node::Node32;
 use crate::math::V3;
+use rayon::prelude::*;
 
 /// The walk's stack: deep enough for any tree the build makes
 /// (`bvh_build::SAH_DEPTH`).
 const STACK: usize = SAH_DEPTH + 66;
+
+/// Subtrees `nearest_to` shares among threads: enough for a few per
+/// thread on a small machine, few enough that each prunes on its own.
+const NEAREST_SPLIT: usize = 16;
 
 /// The hierarchy; `order[k]` is the input index of the item at position k.
 #[derive(Clone, Debug)]
@@ -117,6 +122,73 @@ impl Bvh {
             }
         }
         false
+    }
+
+    /// The least of `item(k)` over every item, where `item` is a distance
+    /// from `p` that is never less than the distance from `p` to the
+    /// item's box: boxes nearer than the best so far are opened, nearer
+    /// first, so a mesh's nearest triangle costs a walk, not a pass over
+    /// every triangle. The tree's top levels are split among the rayon
+    /// pool's threads (a point as far from every item, a sphere's centre,
+    /// opens every box); the least of exact values is the same for any
+    /// number of threads. Infinity for an empty tree.
+    pub fn nearest_to(&self, p: V3, item: impl Fn(usize) -> f64 + Sync) -> f64 {
+        if self.order.is_empty() {
+            return f64::INFINITY;
+        }
+        let mut roots = vec![0usize];
+        while roots.len() < NEAREST_SPLIT && roots.iter().any(|&i| self.nodes[i].count == 0) {
+            roots = roots
+                .iter()
+                .flat_map(|&i| match self.nodes[i].count {
+                    0 => vec![
+                        self.nodes[i].first as usize,
+                        self.nodes[i].first as usize + 1,
+                    ],
+                    _ => vec![i],
+                })
+                .collect();
+        }
+        roots
+            .par_iter()
+            .map(|&root| self.nearest_below(root, p.to_array(), &item))
+            .reduce(|| f64::INFINITY, f64::min)
+    }
+
+    /// `nearest_to` within the subtree at `root`, on one thread.
+    fn nearest_below(&self, root: usize, p: [f64; 3], item: &impl Fn(usize) -> f64) -> f64 {
+        let gap = |n: &Node32| -> f64 {
+            (0..3)
+                .map(|a| {
+                    let d = (f64::from(n.lo[a]) - p[a]).max(p[a] - f64::from(n.hi[a]));
+                    d.max(0.0).powi(2)
+                })
+                .sum::<f64>()
+                .sqrt()
+        };
+        let mut best = f64::INFINITY;
+        let mut stack = vec![(root, gap(&self.nodes[root]))];
+        while let Some((i, g)) = stack.pop() {
+            if g >= best {
+                continue;
+            }
+            let n = &self.nodes[i];
+            if n.count > 0 {
+                for k in n.first as usize..(n.first + n.count) as usize {
+                    best = best.min(item(k));
+                }
+                continue;
+            }
+            let (l, r) = (n.first as usize, n.first as usize + 1);
+            let (gl, gr) = (gap(&self.nodes[l]), gap(&self.nodes[r]));
+            // the nearer child is popped first
+            if gl <= gr {
+                stack.extend([(r, gr), (l, gl)]);
+            } else {
+                stack.extend([(l, gl), (r, gr)]);
+            }
+        }
+        best
     }
 
     /// Visits the items of the leaves whose boxes the ray meets before the

@@ -35,13 +35,16 @@ const PROBES: [[f64; 3]; 3] = [
 
 /// The largest ball, of two candidate centres (the bounding box's and the
 /// vertices' mean), inside the closed mesh of `positions` and `triangles`;
-/// `crossings(o, d)` counts the triangles the ray o + t d (t > 0) meets.
+/// `crossings(o, d)` counts the triangles the ray o + t d (t > 0) meets and
+/// `distance(c)` is the distance from c to the nearest triangle (both
+/// asked of the caller's BVH).
 /// `None` when the mesh is not closed or neither centre is inside.
 pub fn find(
     positions: &[[f64; 3]],
     triangles: &[[u32; 3]],
     bounds: (V3, V3),
     crossings: impl Fn(V3, V3) -> usize,
+    distance: impl Fn(V3) -> f64,
 ) -> Option<Ball> {
     if !closed(positions, triangles) {
         return None;
@@ -58,7 +61,7 @@ pub fn find(
         .filter_map(|c| {
             // shrunk far beyond rounding error, so that the ball stays off
             // the surface in whatever frame the test is made
-            let r = distance(positions, triangles, c) * (1.0 - 1e-6) - 1e-9 * size;
+            let r = distance(c) * (1.0 - 1e-6) - 1e-9 * size;
             (r > 1e-6 * size).then_some(Ball { c, r })
         })
         .max_by(|a, b| a.r.total_cmp(&b.r))
@@ -69,7 +72,8 @@ pub fn find(
 /// of the vertices as numbered first: a well-made closed mesh passes
 /// there, and only one that does not has its vertices welded (seams).
 fn closed(positions: &[[f64; 3]], triangles: &[[u32; 3]]) -> bool {
-    if even_edges(triangles, |i| i) {
+    let n = positions.len();
+    if even_edges(n, triangles, |i| i) {
         return true;
     }
     // vertices at the same point get one id: the first of them in an order
@@ -82,35 +86,46 @@ fn closed(positions: &[[f64; 3]], triangles: &[[u32; 3]]) -> bool {
         let same = k > 0 && key(by_pos[k - 1]) == key(i);
         id[i as usize] = if same { id[by_pos[k - 1] as usize] } else { i };
     }
-    even_edges(triangles, |i| id[i as usize])
+    even_edges(n, triangles, |i| id[i as usize])
 }
 
-/// True when every edge, its ends numbered by `id`, is shared by an even
-/// number of triangles.
-fn even_edges(triangles: &[[u32; 3]], id: impl Fn(u32) -> u32 + Sync) -> bool {
-    let mut edges: Vec<u64> = triangles
-        .par_iter()
-        .flat_map_iter(|t| {
-            let v = t.map(&id);
-            [(v[0], v[1]), (v[1], v[2]), (v[2], v[0])]
-                .into_iter()
-                .filter(|(a, b)| a != b)
-                .map(|(a, b)| (a.min(b) as u64) << 32 | a.max(b) as u64)
-        })
-        .collect();
-    edges.par_sort_unstable();
-    edges.chunk_by(|a, b| a == b).all(|run| run.len() % 2 == 0)
+/// True when every edge, its ends numbered by `id` (each below `n`), is
+/// shared by an even number of triangles. The edges are bucketed by
+/// their lower end (a counting sort, linear in the edges: a comparison
+/// sort of a million-triangle mesh's three million edges cost more than
+/// the rest of the inner ball together), then each vertex's few are
+/// sorted and counted.
+fn even_edges(n: usize, triangles: &[[u32; 3]], id: impl Fn(u32) -> u32) -> bool {
+    let edges = |t: &[u32; 3]| {
+        let v = t.map(&id);
+        [(v[0], v[1]), (v[1], v[2]), (v[2], v[0])]
+            .into_iter()
+            .filter(|(a, b)| a != b)
+            .map(|(a, b)| (a.min(b) as usize, a.max(b)))
+    };
+    let mut start = vec![0usize; n + 1];
+    for (a, _) in triangles.iter().flat_map(edges) {
+        start[a + 1] += 1;
+    }
+    for k in 0..n {
+        start[k + 1] += start[k];
+    }
+    let mut fill = start.clone();
+    let mut upper = vec![0u32; start[n]];
+    for (a, b) in triangles.iter().flat_map(edges) {
+        upper[fill[a]] = b;
+        fill[a] += 1;
+    }
+    (0..n).all(|a| {
+        let ends = &mut upper[start[a]..start[a + 1]];
+        ends.sort_unstable();
+        ends.chunk_by(|x, y| x == y).all(|run| run.len() % 2 == 0)
+    })
 }
 
-/// The distance from `c` to the nearest triangle.
-fn distance(positions: &[[f64; 3]], triangles: &[[u32; 3]], c: V3) -> f64 {
-    triangles
-        .par_iter()
-        .map(|t| {
-            let [a, b, d] = t.map(|i| V3::from(positions[i as usize]));
-            (closest_on_triangle(c, a, b, d) - c).length()
-        })
-        .reduce(|| f64::INFINITY, f64::min)
+/// The distance from `p` to the triangle abc.
+pub fn triangle_distance(p: V3, a: V3, b: V3, c: V3) -> f64 {
+    (closest_on_triangle(p, a, b, c) - p).length()
 }
 
 /// The point of triangle abc nearest p: by which of its seven regions
@@ -197,6 +212,16 @@ mod tests {
             .count()
     }
 
+    /// The distance to the nearest triangle by brute force.
+    fn near(p: &[[f64; 3]], t: &[[u32; 3]], c: V3) -> f64 {
+        t.iter()
+            .map(|t| {
+                let [a, b, d] = t.map(|i| V3::from(p[i as usize]));
+                triangle_distance(c, a, b, d)
+            })
+            .fold(f64::INFINITY, f64::min)
+    }
+
     fn bounds() -> (V3, V3) {
         (V3::new(-1.0, -1.0, -1.0), V3::new(1.0, 1.0, 1.0))
     }
@@ -204,13 +229,27 @@ mod tests {
     #[test]
     fn a_closed_box_holds_a_ball_as_wide_as_the_box_and_an_open_one_none() {
         let (p, t) = cube();
-        let ball = find(&p, &t, bounds(), |o, d| count(&p, &t, o, d)).expect("a closed box");
+        let ball = find(
+            &p,
+            &t,
+            bounds(),
+            |o, d| count(&p, &t, o, d),
+            |c| near(&p, &t, c),
+        )
+        .expect("a closed box");
         assert!(
             ball.c.length() < 1e-12 && ball.r > 0.999 && ball.r < 1.0,
             "{ball:?}"
         );
         let open = &t[1..];
-        assert!(find(&p, open, bounds(), |o, d| count(&p, open, o, d)).is_none());
+        assert!(find(
+            &p,
+            open,
+            bounds(),
+            |o, d| count(&p, open, o, d),
+            |c| near(&p, open, c)
+        )
+        .is_none());
     }
 
     /// Vertices repeated at the same point (a seam) still close the
@@ -223,14 +262,21 @@ mod tests {
         for tri in t.iter_mut().skip(6) {
             *tri = tri.map(|i| i + n);
         }
-        assert!(find(&p, &t, bounds(), |o, d| count(&p, &t, o, d)).is_some());
+        assert!(find(
+            &p,
+            &t,
+            bounds(),
+            |o, d| count(&p, &t, o, d),
+            |c| near(&p, &t, c)
+        )
+        .is_some());
         let (mut p, mut t) = cube();
         let moved: Vec<[f64; 3]> = p.iter().map(|v| [v[0] + 3.0, v[1], v[2]]).collect();
         p.iter_mut().for_each(|v| v[0] -= 3.0);
         t.extend(t.clone().iter().map(|x| x.map(|i| i + 8)));
         p.extend(moved);
         let b = (V3::new(-4.0, -1.0, -1.0), V3::new(4.0, 1.0, 1.0));
-        assert!(find(&p, &t, b, |o, d| count(&p, &t, o, d)).is_none());
+        assert!(find(&p, &t, b, |o, d| count(&p, &t, o, d), |c| near(&p, &t, c)).is_none());
     }
 
     #[test]

@@ -11,6 +11,7 @@ use super::inner_ball::{self, Ball};
 use crate::math::V3;
 use crate::scene::mesh::{self, Mesh};
 use crate::scene::transform::Affine;
+use rayon::prelude::*;
 use std::collections::HashMap;
 use std::path::Path;
 use std::sync::{Arc, Mutex, OnceLock};
@@ -74,12 +75,13 @@ impl TriMesh {
             e1: p(t[1]) - p(t[0]),
             e2: p(t[2]) - p(t[0]),
         };
-        let sorted = bvh.order.iter().map(|&i| &m.triangles[i as usize]);
-        let tris = sorted.clone().map(tri).collect();
+        // gathers of a million triangles each: on the pool's threads
+        let sorted = || bvh.order.par_iter().map(|&i| &m.triangles[i as usize]);
+        let tris = sorted().map(tri).collect();
         let normals = if m.normals.is_empty() {
             Vec::new()
         } else {
-            sorted
+            sorted()
                 .map(|t| t.map(|i| V3::from(m.normals[i as usize])))
                 .collect()
         };
@@ -108,13 +110,27 @@ impl TriMesh {
             ball: None,
         };
         let bounds = (t.bounds.lo, t.bounds.hi);
-        t.ball = inner_ball::find(&m.positions, &m.triangles, bounds, |o, d| t.crossings(o, d));
+        t.ball = inner_ball::find(
+            &m.positions,
+            &m.triangles,
+            bounds,
+            |o, d| t.crossings(o, d),
+            |c| t.distance(c),
+        );
         t
     }
 
     /// True when the mesh is closed and holds an inner ball.
     pub fn has_inner_ball(&self) -> bool {
         self.ball.is_some()
+    }
+
+    /// The distance from `c` to the nearest triangle, through the BVH.
+    fn distance(&self, c: V3) -> f64 {
+        self.bvh.nearest_to(c, |k| {
+            let t = &self.tris[k];
+            inner_ball::triangle_distance(c, t.v0, t.v0 + t.e1, t.v0 + t.e2)
+        })
     }
 
     /// The number of triangles the ray o + t d meets (t > EPS).
@@ -476,6 +492,43 @@ mod tests {
             normals: Vec::new(),
             texcoords: Vec::new(),
             triangles,
+        }
+    }
+
+    /// The BVH's nearest-triangle walk finds what a pass over every
+    /// triangle finds, from points inside, among and far from a soup of
+    /// 3,000 small triangles (a tree many levels deep).
+    #[test]
+    fn the_nearest_triangle_through_the_tree_is_the_nearest_of_all() {
+        let w = |f: f64| (f.sin() * 43758.5453).fract();
+        let mut positions = Vec::new();
+        for i in 0..9000 {
+            let f = i as f64;
+            let centre = [w(f * 1.1), w(f * 2.3 + 0.5), w(f * 3.7 + 0.2)].map(|x| x * 4.0);
+            let k = (i / 3) as f64;
+            let corner = [w(k * 1.9), w(k * 0.7 + 0.3), w(k * 5.1)].map(|x| x * 4.0);
+            positions.push([0, 1, 2].map(|a| corner[a] + 0.05 * centre[a]));
+        }
+        let triangles = (0..3000).map(|t| [3 * t, 3 * t + 1, 3 * t + 2]).collect();
+        let m = Mesh {
+            positions,
+            normals: Vec::new(),
+            texcoords: Vec::new(),
+            triangles,
+        };
+        let t = TriMesh::new(&m);
+        for i in 0..300 {
+            let f = i as f64 + 0.5;
+            let c = V3::new(w(f * 0.31), w(f * 0.77), w(f * 1.13)) * 12.0 - V3::new(4.0, 4.0, 4.0);
+            let all = m.triangles.iter().fold(f64::INFINITY, |best, tri| {
+                let [a, b, d] = tri.map(|v| V3::from(m.positions[v as usize]));
+                best.min(inner_ball::triangle_distance(c, a, b, d))
+            });
+            let walk = t.distance(c);
+            assert!(
+                (walk - all).abs() <= 1e-9 * (1.0 + all),
+                "point {i}: {walk} against {all}"
+            );
         }
     }
 
