@@ -90,10 +90,10 @@ fn a_set_of_two_photographs_goes_through_the_same_entry_point() {
             Shot {
                 name: name.clone(),
                 scene: start.clone(),
-                target: FitTarget {
+                target: std::sync::Arc::new(FitTarget {
                     path: Some(file.clone()),
                     ..target(image)
-                },
+                }),
                 entry: Entry {
                     name,
                     target: file,

@@ -283,7 +283,7 @@ fn shared_block(
         .collect();
     let session = renderer.session(&bases[0], &varying(space, shots), config.fit.jobs)?;
     (steps.clear)()?;
-    let targets = shots.iter().map(|s| &s.target).collect();
+    let targets = shots.iter().map(|s| &*s.target).collect();
     let seed = block_seed(config.fit.de.seed, state.blocks_done, 0);
     let mut problem = ShotsProblem::new(session, shared.clone(), bases, targets, seed);
     let cfg = block_config(&config.fit, shared.dim(), seed);

@@ -22,6 +22,7 @@ use crate::scene::{Field, Override, ParamSpace, Scene};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 pub const FORMAT: &str = "scenefit-shots/1";
 /// The largest shots file read, bytes.
@@ -62,7 +63,9 @@ pub struct Shot {
     pub name: String,
     /// The scene with this shot's `set` values.
     pub scene: Scene,
-    pub target: FitTarget,
+    /// Shared: a shot is cloned for every model the diagnosis refits,
+    /// and its photograph need not be.
+    pub target: Arc<FitTarget>,
     /// The entry with absolute paths (written into the run directory so
     /// that `diagnose` finds the photographs).
     pub entry: Entry,
@@ -83,7 +86,7 @@ impl Shot {
         Shot {
             name: entry.name.clone(),
             scene: scene.clone(),
-            target,
+            target: Arc::new(target),
             entry,
         }
     }
@@ -271,7 +274,7 @@ fn shot(
         Shot {
             name: e.name.clone(),
             scene: shot_scene,
-            target,
+            target: Arc::new(target),
             entry: e,
         },
         note,
