@@ -35,7 +35,7 @@
 //! 8-bit, and carry over from one local run to the next. A periodic
 //! coordinate (a hue, [`Hybrid::set_periods`]) steps round its circle
 //! instead of stopping at a face (`lm::wrap`). When a run finds its
-//! sharp difference columns to be noise (edges that move in sample
+//! sharp difference columns noise, even one (edges that move in sample
 //! steps), it descends blurred residuals first (`pyramid.rs`), and every
 //! later run starts coarse.
 //!
@@ -191,7 +191,7 @@ pub struct Hybrid {
     /// Local runs of earlier populations.
     #[serde(default)]
     earlier_local_runs: usize,
-    /// Whether a local run found the sharp difference columns to be noise:
+    /// Whether a local run found a sharp difference column to be noise:
     /// every later run then starts coarse (`pyramid.rs`).
     #[serde(default)]
     rough: bool,
