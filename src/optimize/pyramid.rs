@@ -17,7 +17,8 @@
 //! **When.** Automatically: a sharp Jacobian with a column that is noise
 //! ([`rough`]: among its resolved columns, one whose forward and backward
 //! differences have a cosine below [`AGREE_MIN`]) sends the run to the
-//! coarsest level, and the hybrid starts every later local run there. One
+//! coarsest level (each local run decides at its own first sharp
+//! Jacobian). One
 //! such column is enough: the step along it is noise whatever the others
 //! are (on a thin shadow the sun's three direction columns agree at
 //! 0.0–0.3 while the intensity's and the floor colour's four agree at 1.00,
