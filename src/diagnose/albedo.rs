@@ -2,8 +2,9 @@
 //! frame (`material.color_map`), a multiplier of the diffuse colour per
 //! texel and channel, shared by every photograph and solved from all of
 //! them that see the texel, whatever the camera and light of each
-//! (`texels.rs`; the resolution in `texel_layout.rs`). No search could
-//! fit it. Values with evidence in fewer than two photographs stay 1 (the
+//! (`texels.rs`; the finest resolution the samples support in
+//! `texel_layout.rs`, the side kept chosen by the criterion in
+//! `solve_for`). No search could fit it. Values with evidence in fewer than two photographs stay 1 (the
 //! scalar colour) and are not counted, so on a single photograph nothing
 //! is solved and the effect is no candidate; nor are values whose drop of
 //! the SAD does not pay for them in the criterion.
@@ -18,7 +19,8 @@ use super::effects::covered;
 use super::inputs::Params;
 use super::model::{shots_of, Model};
 use super::refits::Refits;
-use super::texel_layout::layouts;
+use super::selection::{delta_bic, overdispersion};
+use super::texel_layout::{layouts, Layout, MAX_MAP_SIDE};
 use super::texels::{self, Evidence};
 use crate::error::{Error, Result};
 use crate::fit::set::shots::Shot;
@@ -39,10 +41,13 @@ fn with_maps(scene: &Scene, maps: &[(usize, TextureRef)]) -> Scene {
 }
 
 /// The map file of object `object` in round `round` (`first`: before the
-/// refit).
-fn map_path(out: &Path, round: usize, first: bool, object: usize) -> PathBuf {
+/// refit) at side `side` (each side its own file: texels are read once per
+/// process and path).
+fn map_path(out: &Path, round: usize, first: bool, object: usize, side: u32) -> PathBuf {
     let stage = if first { "_first" } else { "" };
-    let p = out.join(format!("albedo_map_round{round}{stage}_object{object}.png"));
+    let p = out.join(format!(
+        "albedo_map_round{round}{stage}_object{object}_side{side}.png"
+    ));
     std::path::absolute(&p).unwrap_or(p)
 }
 
@@ -127,6 +132,15 @@ fn evidence<'a>(
 /// The maps solved for `scene` with each photograph's `own` values,
 /// written into the diagnosis directory; the scene naming them and the
 /// values solved, or None when no value could be solved.
+///
+/// The finest side the samples support (`texel_layout.rs`) is a ceiling,
+/// not a choice: the maps are solved at it and at each coarser side in
+/// turn (every object's side halved), each model scored by the criterion
+/// the round applies (`selection::delta_bic`, with the overdispersion of
+/// its own residuals), and the best kept; the search stops at the first
+/// side that scores worse than the finer one. A finer map thus buys its
+/// texels only where its drop in SAD pays for them; `--map-size` fixes
+/// the side instead.
 fn solve_for(
     fits: &mut Refits,
     scene: &Scene,
@@ -142,14 +156,71 @@ fn solve_for(
             (&e.coords, Mask::counted(e.mask, (w * h) as usize))
         })
         .collect();
-    let layouts = layouts(scene, &covered, &inside, fits.config.map_size);
-    let solved = texels::solve(&evidence, &layouts, scene.camera.response);
+    let ceiling = layouts(scene, &covered, &inside, fits.config.map_size);
+    let written = |fits: &mut Refits, layouts: &[Option<Layout>]| {
+        written_maps(fits, scene, &evidence, layouts, (round, first))
+    };
+    if fits.config.map_size.is_some() {
+        return written(fits, &ceiling);
+    }
+    let (n, sad0) = texels::totals(&evidence);
+    let mut best: Option<(f64, Scene, usize)> = None;
+    for shift in 0..=MAX_MAP_SIDE.trailing_zeros() {
+        let sides = coarser(&ceiling, shift);
+        if shift > 0 && sides == coarser(&ceiling, shift - 1) {
+            break;
+        }
+        let Some((s, count)) = written(fits, &sides)? else {
+            break;
+        };
+        let Some(m) = fits.model_of(s.clone(), own)? else {
+            break;
+        };
+        let c = overdispersion(
+            m.images
+                .iter()
+                .zip(&fits.inputs.shots)
+                .map(|(img, shot)| (&shot.target.image, img, shot.target.mask.as_ref())),
+        );
+        let score = delta_bic(sad0, m.sad, n, count, c);
+        if best.as_ref().is_some_and(|b| score >= b.0) {
+            break;
+        }
+        best = Some((score, s, count));
+    }
+    Ok(best.map(|(_, s, count)| (s, count)))
+}
+
+/// `ceiling` with every side shifted down by `shift` (at least 1).
+fn coarser(ceiling: &[Option<Layout>], shift: u32) -> Vec<Option<Layout>> {
+    ceiling
+        .iter()
+        .map(|l| {
+            l.map(|l| Layout {
+                side: (l.side >> shift).max(1),
+                ..l
+            })
+        })
+        .collect()
+}
+
+/// The maps solved at `layouts` from `evidence`, written into the
+/// diagnosis directory; `scene` naming them and the values solved (None:
+/// nothing solved).
+fn written_maps(
+    fits: &Refits,
+    scene: &Scene,
+    evidence: &[Evidence],
+    layouts: &[Option<Layout>],
+    (round, first): (usize, bool),
+) -> Result<Option<(Scene, usize)>> {
+    let solved = texels::solve(evidence, layouts, scene.camera.response);
     if solved.is_empty() {
         return Ok(None);
     }
     let mut refs = Vec::new();
     for map in &solved {
-        let path = map_path(fits.out, round, first, map.object);
+        let path = map_path(fits.out, round, first, map.object, map.layout.side);
         refs.push((map.object, super::map_file::write(&path, map)?));
     }
     let count = solved.iter().map(|m| m.count).sum();

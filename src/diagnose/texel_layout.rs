@@ -1,14 +1,34 @@
 //! Where a colour texture solved in the object's frame (`texels.rs`) puts
 //! each pixel: per object, the side of its square map and the scale of
-//! its texture coordinates. The side is chosen from how many pixels see
-//! the object over every photograph (the largest power of two at which
-//! three quarters of those pixels lie in texels holding at least
-//! `SAMPLES_PER_TEXEL` of them), or fixed by
-//! `diagnose --map-size`; at most `MAX_MAP_SIDE` either way, which bounds
-//! a map's memory (1024² texels: 12 MiB of floats). A plane's coordinates
-//! are metres without bound, so its map is scaled to hold the region the
-//! photographs see in one tile (the lookup repeats, so the offset does
-//! not matter); the other shapes' coordinates span [0, 1] already.
+//! its texture coordinates.
+//!
+//! The side follows the evidence: the samples are every counted pixel of
+//! every photograph that sees the object, so a fixed camera with eight
+//! photographs gives a pixel-sized texel eight samples, and a camera that
+//! moves spreads its samples over new places. It is the largest power of
+//! two at which the median texel seen holds at least `MIN_SAMPLES`
+//! samples: counted over the samples, not assumed from an image's pixels,
+//! so it holds for a longitude/latitude sphere or a plane in perspective,
+//! whose footprint varies over the surface. With a fixed camera every
+//! texel seen holds as many samples as photographs, so from three on the
+//! side is the largest allowed: a value per surface point that every
+//! photograph pins.
+//! Whether each value pays for itself is the criterion's to say
+//! (`texels.rs` keeps one only when the SAD of its samples falls by more
+//! than it costs), so a finer map must still earn its values.
+//! `diagnose --map-size` fixes the side instead; at most `MAX_MAP_SIDE`
+//! either way, which bounds a map's memory (1024² texels: 12 MiB of
+//! floats). Whether a finer map's values pay for themselves is the
+//! criterion's to say (`texels.rs` keeps a value only when it does).
+//!
+//! A plane's coordinates are metres without bound, so its map is scaled
+//! to hold in one tile the region where most samples lie (the middle
+//! `1 - 2 PLANE_TAIL` of them along each direction): a plane seen towards
+//! its horizon has a few pixels spread over hundreds of metres, and a
+//! tile stretched over them left the near field, where most pixels are,
+//! with texels many pixels wide. Those few pixels fall on the repeated
+//! tile (the lookup repeats, so the offset does not matter either); the
+//! other shapes' coordinates span [0, 1] already.
 
 use crate::render::SurfaceCoords;
 use crate::scene::{Scene, Shape};
@@ -16,15 +36,16 @@ use crate::scene::{Scene, Shape};
 /// The largest side of a solved map, texels.
 pub const MAX_MAP_SIDE: u32 = 1024;
 
-/// Pixels a texel needs to count as densely seen: fewer, and its value
-/// rests on one or two pixels, where noise decides it.
-const SAMPLES_PER_TEXEL: f64 = 16.0;
+/// Samples the median texel seen needs: one value per texel and channel
+/// rests on a weighted median of its samples' ratios (`texel_fit.rs`), and
+/// three is the fewest at which that median survives one sample the model
+/// misreads (a highlight, a shadow it lacks) and the value is checked by
+/// two samples besides the one that sets it.
+const MIN_SAMPLES: usize = 3;
 
-/// The share of the pixels that must lie in densely seen texels. Not an
-/// average over the texels seen: near the silhouette a pixel spans many
-/// texels, and those sparse texels pulled an average (8 a texel) down to
-/// a map too coarse for the texture.
-const DENSE: f64 = 0.75;
+/// The share of a plane's samples left outside its tile at each end of
+/// each direction (`plane_scale`).
+const PLANE_TAIL: f64 = 0.05;
 
 /// One object's map: its side and the scale of (u, v).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -104,15 +125,17 @@ pub fn layouts(
         .collect()
 }
 
-/// The scale that maps the extent of `uvs` to a little under one tile.
+/// The scale that maps the middle `1 - 2 PLANE_TAIL` of `uvs` along each
+/// direction to a little under one tile.
 fn plane_scale(uvs: &[[f64; 2]]) -> [f64; 2] {
     let extent = |k: usize| {
-        let (lo, hi) = uvs
-            .iter()
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
-                (lo.min(p[k]), hi.max(p[k]))
-            });
-        hi - lo
+        let mut v: Vec<f64> = uvs.iter().map(|p| p[k]).filter(|x| x.is_finite()).collect();
+        if v.is_empty() {
+            return 0.0;
+        }
+        v.sort_by(f64::total_cmp);
+        let at = |q: f64| v[((v.len() - 1) as f64 * q).round() as usize];
+        at(1.0 - PLANE_TAIL) - at(PLANE_TAIL)
     };
     [0, 1].map(|k| {
         let e = extent(k);
@@ -124,28 +147,32 @@ fn plane_scale(uvs: &[[f64; 2]]) -> [f64; 2] {
     })
 }
 
-/// The largest power of two at which `DENSE` of `uvs` lie in texels
-/// holding `SAMPLES_PER_TEXEL` of them at least (1 when none does).
+/// Per texel of a `side` map, the samples among `uvs` its cell holds.
+fn counts(uvs: &[[f64; 2]], side: u32, scale: [f64; 2]) -> Vec<u32> {
+    let layout = Layout { side, scale };
+    let mut count = vec![0u32; (side * side) as usize];
+    for &uv in uvs {
+        count[layout.texel(uv)] += 1;
+    }
+    count
+}
+
+/// The largest power of two at which the median texel seen holds
+/// `MIN_SAMPLES` of `uvs` (1 when no finer side does).
 fn chosen_side(uvs: &[[f64; 2]], scale: [f64; 2]) -> u32 {
     let mut side = 1;
     while side < MAX_MAP_SIDE {
-        let next = Layout {
-            side: side * 2,
-            scale,
-        };
-        let mut count = vec![0u32; (next.side * next.side) as usize];
-        for &uv in uvs {
-            count[next.texel(uv)] += 1;
-        }
-        let dense: u64 = count
-            .iter()
-            .filter(|&&c| c as f64 >= SAMPLES_PER_TEXEL)
-            .map(|&c| c as u64)
-            .sum();
-        if (dense as f64) < DENSE * uvs.len() as f64 {
+        let count = counts(uvs, side * 2, scale);
+        let mut held: Vec<u32> = count.iter().copied().filter(|&n| n > 0).collect();
+        if held.is_empty() {
             break;
         }
-        side = next.side;
+        let middle = held.len() / 2;
+        let (_, median, _) = held.select_nth_unstable(middle);
+        if (*median as usize) < MIN_SAMPLES {
+            break;
+        }
+        side *= 2;
     }
     side
 }
@@ -176,25 +203,55 @@ mod tests {
         assert_eq!((t[0], t[1], w[0], w[1]), (1, 2, 0.5, 0.5));
     }
 
+    /// A grid of n x n points over the whole square, `photos` times.
+    fn grid(n: usize, photos: usize) -> Vec<[f64; 2]> {
+        (0..photos * n * n)
+            .map(|k| {
+                let k = k % (n * n);
+                [
+                    ((k % n) as f64 + 0.5) / n as f64,
+                    ((k / n) as f64 + 0.5) / n as f64,
+                ]
+            })
+            .collect()
+    }
+
     #[test]
-    fn the_side_grows_with_the_pixels_that_see_the_object() {
-        // A grid of n x n points over the whole square: n² / side² per
-        // texel, at least 16 kept.
-        let grid = |n: usize| -> Vec<[f64; 2]> {
-            (0..n * n)
-                .map(|k| {
-                    [
-                        ((k % n) as f64 + 0.5) / n as f64,
-                        ((k / n) as f64 + 0.5) / n as f64,
-                    ]
-                })
-                .collect()
-        };
-        assert_eq!(chosen_side(&grid(64), [1.0, 1.0]), 16, "16 per texel at 16");
-        assert_eq!(chosen_side(&grid(128), [1.0, 1.0]), 32);
-        assert_eq!(chosen_side(&grid(2), [1.0, 1.0]), 1);
-        // A plane seen over 3 m by 1 m fits one tile.
-        let s = plane_scale(&[[-1.0, 0.0], [2.0, 1.0]]);
-        assert!(s[0] * 3.0 < 1.0 && s[0] * 3.0 > 0.99 && s[1] < 1.0 && s[1] > 0.99);
+    fn the_side_follows_the_samples_of_every_photograph() {
+        // One photograph: a texel needs three samples, so four pixels.
+        assert_eq!(chosen_side(&grid(64, 1), [1.0, 1.0]), 32);
+        assert_eq!(chosen_side(&grid(2, 1), [1.0, 1.0]), 1);
+        // Eight from one place (a fixed camera): every texel seen holds
+        // eight samples however fine, so the largest side.
+        assert_eq!(chosen_side(&grid(64, 8), [1.0, 1.0]), MAX_MAP_SIDE);
+        // Eight photographs each from its own place (a camera that
+        // moves): eight samples a 64-texel cell, two a 128-texel one.
+        let moved: Vec<[f64; 2]> = (0..8)
+            .flat_map(|k| {
+                let d = [
+                    ((k % 4) as f64 - 1.5) / 256.0,
+                    ((k / 4) as f64 - 0.5) / 128.0,
+                ];
+                grid(64, 1)
+                    .into_iter()
+                    .map(move |p| [p[0] + d[0], p[1] + d[1]])
+            })
+            .collect();
+        assert_eq!(chosen_side(&moved, [1.0, 1.0]), 64);
+    }
+
+    #[test]
+    fn a_plane_tile_holds_where_most_samples_lie() {
+        // A plane seen over 3 m by 1 m fits one tile...
+        let mut pts: Vec<[f64; 2]> = (0..=100)
+            .map(|i| [-1.0 + 3.0 * i as f64 / 100.0, i as f64 / 100.0])
+            .collect();
+        let s = plane_scale(&pts);
+        let (a, b) = (s[0] * 2.7, s[1] * 0.9);
+        assert!(a < 1.0 && a > 0.99 && b < 1.0 && b > 0.99, "{s:?}");
+        // ... and a few samples far off towards a horizon do not stretch it.
+        pts.extend([[-300.0, 500.0], [250.0, 900.0]]);
+        let t = plane_scale(&pts);
+        assert!(t[0] < 1.05 * s[0] && t[0] > 0.95 * s[0], "{t:?}");
     }
 }

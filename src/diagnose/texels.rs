@@ -96,6 +96,13 @@ fn samples(evidence: &[Evidence], layouts: &[Option<Layout>]) -> (Vec<Vec<Sample
     (out, n, sad)
 }
 
+/// The criterion's N (channel values counted over every photograph) and
+/// the SAD of the model without the maps over them.
+pub fn totals(evidence: &[Evidence]) -> (f64, f64) {
+    let (_, n, sad) = samples(evidence, &[]);
+    (n, sad)
+}
+
 /// Solves each laid-out object's map from every photograph's evidence.
 /// A value is kept only when it earns its place in the criterion:
 /// `BIC = 2N ln(SAD/N) + k ln N` falls by adding it when the SAD of the
