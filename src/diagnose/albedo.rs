@@ -137,8 +137,8 @@ fn evidence<'a>(
 /// not a choice: the maps are solved at it and at each coarser side in
 /// turn (every object's side halved), each model scored by the criterion
 /// the round applies (`selection::delta_bic`, with the overdispersion of
-/// its own residuals), and the best kept; the search stops at the first
-/// side that scores worse than the finer one. A finer map thus buys its
+/// the finest side's residuals), and the best kept; the search stops at
+/// the first side that scores worse than the finer one. A finer map thus buys its
 /// texels only where its drop in SAD pays for them; `--map-size` fixes
 /// the side instead.
 fn solve_for(
@@ -165,6 +165,7 @@ fn solve_for(
     }
     let (n, sad0) = texels::totals(&evidence);
     let mut best: Option<(f64, Scene, usize)> = None;
+    let mut c = None;
     for shift in 0..=MAX_MAP_SIDE.trailing_zeros() {
         let sides = coarser(&ceiling, shift);
         if shift > 0 && sides == coarser(&ceiling, shift - 1) {
@@ -176,12 +177,16 @@ fn solve_for(
         let Some(m) = fits.model_of(s.clone(), own)? else {
             break;
         };
-        let c = overdispersion(
-            m.images
-                .iter()
-                .zip(&fits.inputs.shots)
-                .map(|(img, shot)| (&shot.target.image, img, shot.target.mask.as_ref())),
-        );
+        // One overdispersion for every side, the finest's: the most general
+        // model tried, as the round weighs its candidates (`selection::weigh`).
+        let c = *c.get_or_insert_with(|| {
+            overdispersion(
+                m.images
+                    .iter()
+                    .zip(&fits.inputs.shots)
+                    .map(|(img, shot)| (&shot.target.image, img, shot.target.mask.as_ref())),
+            )
+        });
         let score = delta_bic(sad0, m.sad, n, count, c);
         if best.as_ref().is_some_and(|b| score >= b.0) {
             break;
