@@ -1,5 +1,6 @@
 //! `albedo_map`: the scene field (checked, drawn by phong) and the
-//! diagnosis's closed-form effect. A set of eight generated photographs of
+//! diagnosis's closed-form effect (a colour texture in the object's frame,
+//! `material.color_map`). A set of eight generated photographs of
 //! a ball with stains and grain (a map the model lacks) accepts the map
 //! first, and with it the light directions come closer to the truth and
 //! the deviation falls to at most 30 %; a set with noise only and a single
@@ -178,23 +179,37 @@ fn a_planted_map_is_accepted_first_on_a_set_and_frees_the_lights() {
     let e1 = light_error(&d["shots_after"], "params", centre, &truth);
     println!("deviation {before:.3} -> {after:.3}; light error {e0:.2} -> {e1:.2} deg");
     assert!(e1 < e0, "light error {e0:.2} -> {e1:.2} deg");
-    // The diagnosed scene names the map written into the diagnosis and
-    // fits again as it is.
+    // The diagnosed scene names the map written into the diagnosis, by a
+    // path relative to it (a colour texture in the ball's frame).
     let improved = std::fs::read_to_string(dir.path().join("diag/improved_scene.json")).unwrap();
-    let scene = scenefit::scene::parse(&improved, "improved_scene.json", &[]).unwrap();
-    let map = scene.objects[0].material.albedo_map.clone().unwrap();
+    let written: Value = serde_json::from_str(&improved).unwrap();
+    let file = written["objects"][0]["material"]["color_map"]["file"]
+        .as_str()
+        .unwrap()
+        .to_string();
+    assert!(!Path::new(&file).is_absolute(), "{file}");
+    let scene = scenefit::scene::load(&dir.path().join("diag/improved_scene.json")).unwrap();
+    let map = scene.objects[0].material.color_map.clone().unwrap();
+    let map = map.file();
     assert!(
-        Path::new(&map).starts_with(dir.path().join("diag").canonicalize().unwrap())
-            || Path::new(&map).starts_with(dir.path().join("diag"))
+        Path::new(map).starts_with(dir.path().join("diag").canonicalize().unwrap())
+            || Path::new(map).starts_with(dir.path().join("diag"))
     );
-    // ... and it is the only map left there.
-    assert!(Path::new(&map).exists(), "{map} missing");
-    assert_eq!(
-        maps_in(&dir.path().join("diag")).len(),
-        1,
-        "{:?}",
-        maps_in(&dir.path().join("diag"))
-    );
+    // ... and the maps left there are exactly those the scene names (one
+    // per object mapped: the ball and the floor both carry the stains).
+    assert!(Path::new(map).exists(), "{map} missing");
+    let mut named: Vec<String> = written["objects"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter_map(|o| o["material"]["color_map"]["file"].as_str())
+        .map(String::from)
+        .collect();
+    let mut left = maps_in(&dir.path().join("diag"));
+    named.sort();
+    left.sort();
+    assert!(!named.is_empty());
+    assert_eq!(left, named);
 }
 
 /// The albedo-map files in a diagnosis directory.
@@ -203,7 +218,7 @@ fn maps_in(dir: &Path) -> Vec<String> {
         .unwrap()
         .flatten()
         .map(|e| e.file_name().to_string_lossy().into_owned())
-        .filter(|n| n.ends_with(".exr"))
+        .filter(|n| n.starts_with("albedo_map_"))
         .collect()
 }
 

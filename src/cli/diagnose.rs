@@ -47,6 +47,11 @@ pub struct DiagnoseArgs {
     /// fit put them, which saves re-tracing every camera ray.
     #[arg(long)]
     refit_geometry: bool,
+    /// The side, in texels, of the colour maps the `albedo_map` effect
+    /// solves in each object's frame (default: chosen from how many pixels
+    /// see the object; at most 1024).
+    #[arg(long, value_name = "N", value_parser = super::numbers::map_size, allow_hyphen_values = true)]
+    map_size: Option<u32>,
     /// A set of photographs: leave these shots (names as in the fit's
     /// shots file) out of the diagnosis too, and predict them before and
     /// after (diagnosis.json's held_out); the fit's held-out ones always are.
@@ -92,6 +97,7 @@ pub fn run(a: DiagnoseArgs) -> Result<()> {
         restart_generations: a.restart_generations,
         seed: a.seed,
         refit_geometry: a.refit_geometry,
+        map_size: a.map_size,
         ..DiagnoseConfig::default()
     };
     if let Some(j) = a.jobs {

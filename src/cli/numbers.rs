@@ -30,6 +30,17 @@ pub(crate) fn workers(s: &str) -> Result<usize, String> {
     }
 }
 
+/// `diagnose --map-size`: 1 to the largest side of a solved map.
+pub(crate) fn map_size(s: &str) -> Result<u32, String> {
+    let max = crate::diagnose::MAX_MAP_SIDE;
+    match s.trim().parse::<u32>() {
+        Ok(n) if (1..=max).contains(&n) => Ok(n),
+        _ => Err(format!(
+            "expected a whole number from 1 to {max} (texels a side)"
+        )),
+    }
+}
+
 /// A seed: a whole number from 0 to 2^64 - 1.
 pub(crate) fn seed(s: &str) -> Result<u64, String> {
     s.trim()

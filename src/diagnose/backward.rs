@@ -30,14 +30,12 @@ pub fn rebuild(base: &Scene, steps: &[Step], current: &Scene) -> Result<Scene> {
     let mut scene = base.clone();
     for step in steps {
         if step.effect.closed_form() {
-            let map = current
-                .objects
-                .iter()
-                .find_map(|o| o.material.albedo_map.clone());
-            // The map solved in closed form, set as `albedo::with_map` sets
-            // it (not called: albedo.rs uses the refits, which use this).
-            for o in &mut scene.objects {
-                o.material.albedo_map = map.clone();
+            // The colour maps solved in closed form (`albedo.rs`), taken
+            // from the objects of `current` that `base` leaves unmapped.
+            for (o, c) in scene.objects.iter_mut().zip(&current.objects) {
+                if o.material.color_map.is_none() {
+                    o.material.color_map = c.material.color_map.clone();
+                }
             }
         } else if let Some(ext) = effects::forms(step.effect, &scene)
             .into_iter()

@@ -43,6 +43,9 @@ pub struct DiagnoseConfig {
     /// Refit the shared free entries that move geometry too, instead of
     /// holding them where the fit put them (`held.rs`).
     pub refit_geometry: bool,
+    /// The side of the colour maps `albedo_map` solves, texels (None:
+    /// chosen from how many pixels see each object, `texel_layout.rs`).
+    pub map_size: Option<u32>,
 }
 
 impl Default for DiagnoseConfig {
@@ -67,6 +70,7 @@ impl Default for DiagnoseConfig {
                 .unwrap_or(1),
             render_options: Default::default(),
             refit_geometry: false,
+            map_size: None,
         }
     }
 }

@@ -33,6 +33,7 @@ mod held;
 mod imitations;
 mod inputs;
 mod lanes;
+mod map_file;
 mod model;
 mod one_refit;
 pub mod photo;
@@ -45,11 +46,15 @@ mod schedule;
 mod selection;
 mod set_refit;
 mod starts;
+mod texel_fit;
+mod texel_layout;
+mod texels;
 mod trials;
 
 pub use config::DiagnoseConfig;
 pub use diagnosis::{Candidate, Diagnosis, SetDiagnosis, ShotAfter, UNEXPLAINED};
 pub use inputs::{Inputs, SetInputs};
+pub use texel_layout::MAX_MAP_SIDE;
 
 use crate::error::{Error, Result};
 use crate::metric::Deviation;

@@ -39,10 +39,8 @@ pub fn write(
         json(d)?
     };
     write_atomic(&out.join(rundir::DIAGNOSIS_JSON), record.as_bytes())?;
-    write_atomic(
-        &out.join(rundir::IMPROVED_SCENE),
-        json(&model.scene)?.as_bytes(),
-    )?;
+    let scene = super::map_file::beside(&model.scene, out);
+    write_atomic(&out.join(rundir::IMPROVED_SCENE), json(&scene)?.as_bytes())?;
     let scale = before
         .iter()
         .chain(after)

@@ -30,6 +30,7 @@ use crate::scene::{ParamSpace, Scene};
 
 pub use crate::exec::{RenderFailure, RenderOptions, RenderResult};
 pub use crate::raster::Image;
+pub use phong::uv_pass::{surface_coords, SurfaceCoords, SurfacePoint};
 pub use registry::{from_spec, from_spec_with};
 
 /// A backend. `session` prepares it to render many variants of one scene.

@@ -1,6 +1,6 @@
-//! `albedo_map`: the object is not uniform (stains, grain, dust): a map of
-//! multipliers of the diffuse colour, shared by every photograph, in the
-//! image's frame. Solved in closed form per pixel (`diagnose/albedo.rs`),
+//! `albedo_map`: the object is not uniform (print, stains, grain, dust): a
+//! colour texture in the object's frame (`material.color_map`), shared by
+//! every photograph. Solved in closed form per texel (`diagnose/albedo.rs`),
 //! not searched: it adds no free entries.
 
 use super::Effect;
@@ -20,15 +20,10 @@ impl Effect for AlbedoMap {
         vec![f.render.to_vec()]
     }
 
-    /// Applies while no object has a map and some object has a diffuse
-    /// colour for it to multiply.
+    /// Applies while some object has a diffuse colour for it to multiply
+    /// and no map of its own (`covered`).
     fn extend(&self, scene: &Scene) -> Option<(Scene, Vec<FreeParam>)> {
-        let objects = &scene.objects;
-        if objects.iter().any(|o| o.material.albedo_map.is_some())
-            || !objects
-                .iter()
-                .any(|o| o.material.diffuse > 0.0 && o.material.color != [0.0; 3])
-        {
+        if !covered(scene).contains(&true) {
             return None;
         }
         Some((scene.clone(), Vec::new()))
@@ -37,4 +32,21 @@ impl Effect for AlbedoMap {
     fn closed_form(&self) -> bool {
         true
     }
+}
+
+/// The objects the map covers: those with a diffuse colour for it to
+/// multiply and no map of their own (a colour texture, or a map in the
+/// image's frame).
+pub(crate) fn covered(scene: &Scene) -> Vec<bool> {
+    scene
+        .objects
+        .iter()
+        .map(|o| {
+            let m = &o.material;
+            m.diffuse > 0.0
+                && m.color != [0.0; 3]
+                && m.color_map.is_none()
+                && m.albedo_map.is_none()
+        })
+        .collect()
 }

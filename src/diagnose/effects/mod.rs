@@ -8,6 +8,7 @@
 //! trades with. Adding an effect: its module, and one line in [`ALL`].
 
 mod albedo_map;
+pub(crate) use albedo_map::covered;
 mod ambient;
 mod area_light;
 mod camera_response;

@@ -19,8 +19,22 @@ pub fn render_shots(
     jobs: usize,
     seed: u64,
 ) -> Result<Vec<std::result::Result<Image, String>>> {
-    let mut session = renderer.session(&scenes[0], varying, jobs)?;
-    let rendered = session.render_batch(scenes, seed);
+    // A session may keep what its base scene's camera rays hit (the
+    // built-in tracer does when no free entry moves geometry): shots whose
+    // cameras or shapes differ (a shot's known `set` camera) were all drawn
+    // from the first shot's camera. Those get a session each.
+    let rendered = if scenes.iter().all(|s| same_geometry(s, &scenes[0])) {
+        renderer
+            .session(&scenes[0], varying, jobs)?
+            .render_batch(scenes, seed)
+    } else {
+        let mut out = Vec::with_capacity(scenes.len());
+        for s in scenes {
+            let mut session = renderer.session(s, varying, jobs)?;
+            out.extend(session.render_batch(std::slice::from_ref(s), seed));
+        }
+        out
+    };
     Ok(rendered
         .into_iter()
         .zip(shots)
@@ -36,4 +50,14 @@ pub fn render_shots(
             Err(f) => Err(format!("failed: {f}")),
         })
         .collect())
+}
+
+/// Whether `a` and `b` have the same camera and the same shapes where
+/// they are.
+fn same_geometry(a: &Scene, b: &Scene) -> bool {
+    let geometry = |s: &Scene| {
+        let objects: Vec<_> = s.objects.iter().map(|o| (&o.shape, &o.transform)).collect();
+        serde_json::to_value((&s.camera, &s.image, objects)).ok()
+    };
+    geometry(a) == geometry(b)
 }

@@ -34,6 +34,7 @@ mod paths;
 mod shade;
 mod texture;
 mod trimesh;
+pub mod uv_pass;
 
 use super::{Image, RenderFailure, RenderResult, RenderSession, Renderer};
 use crate::error::{Error, Result};

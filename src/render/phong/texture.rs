@@ -100,15 +100,7 @@ impl HitMaps {
             shininess_of: shin.iter().map(Option::is_some).collect(),
         };
         let frames: Vec<Option<Frame>> = scene.objects.iter().map(Frame::of).collect();
-        // each mesh looked up once, not per hit
-        let meshes: Vec<Option<Arc<Mesh>>> = scene
-            .objects
-            .iter()
-            .map(|o| match &o.shape {
-                Shape::Mesh { file } => mesh::get(std::path::Path::new(file)).ok(),
-                _ => None,
-            })
-            .collect();
+        let meshes = object_meshes(scene);
         for (vi, vert) in paths.verts.iter().enumerate() {
             let o = vert.object as usize;
             if color[o].is_none() && spec[o].is_none() && shin[o].is_none() {
@@ -246,4 +238,15 @@ pub(super) fn hit_uv(
     };
     let at = vert.tri?;
     uv::mesh_uv(mesh?, at.tri as usize, at.u, at.v)
+}
+
+/// Each object's mesh (None for a primitive), looked up once per render,
+/// not per hit.
+pub(super) fn object_meshes(scene: &Scene) -> Vec<Option<Arc<Mesh>>> {
+    (scene.objects.iter())
+        .map(|o| match &o.shape {
+            Shape::Mesh { file } => mesh::get(std::path::Path::new(file)).ok(),
+            _ => None,
+        })
+        .collect()
 }
