@@ -4,10 +4,11 @@
 //! them that see the texel, whatever the camera and light of each
 //! (`texels.rs`; the finest resolution the samples support in
 //! `texel_layout.rs`, the side kept chosen by the criterion in
-//! `solve_for`). No search could fit it. Values with evidence in fewer than two photographs stay 1 (the
-//! scalar colour) and are not counted, so on a single photograph nothing
-//! is solved and the effect is no candidate; nor are values whose drop of
-//! the SAD does not pay for them in the criterion.
+//! `solve_for`). No search could fit it. Values with evidence in fewer
+//! than two photographs stay 1 (the scalar colour) and are not counted,
+//! so on a single photograph nothing is solved and the effect is no
+//! candidate; nor are values whose drop of the SAD does not pay for them
+//! in the criterion.
 //!
 //! The map is solved, the model's other free parameters refitted with it
 //! in the scene, and the map solved once more against the refitted model

@@ -18,8 +18,7 @@
 //! than it costs), so a finer map must still earn its values.
 //! `diagnose --map-size` fixes the side instead; at most `MAX_MAP_SIDE`
 //! either way, which bounds a map's memory (1024² texels: 12 MiB of
-//! floats). Whether a finer map's values pay for themselves is the
-//! criterion's to say (`texels.rs` keeps a value only when it does).
+//! floats).
 //!
 //! A plane's coordinates are metres without bound, so its map is scaled
 //! to hold in one tile the region where most samples lie (the middle
