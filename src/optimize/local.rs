@@ -21,8 +21,8 @@
 //! shortens a step spans many orders of magnitude, and a fixed factor from
 //! a small λ gives back the same trial, paid for with another render.
 //!
-//! **Coarse to fine** (`pyramid.rs`). When a sharp Jacobian's columns
-//! are noise, the run goes on at [`pyramid::BLUR_START`] pixels of blur:
+//! **Coarse to fine** (`pyramid.rs`). When a column of a sharp Jacobian
+//! is noise, the run goes on at [`pyramid::BLUR_START`] pixels of blur:
 //! its Jacobians, trials and acceptance all use the residuals of blurred
 //! images (the sharp fitness is still what the hybrid keeps as the best).
 //! What would end a run at a blurred level instead halves the blur and
@@ -121,7 +121,7 @@ pub struct Local {
     /// (`pyramid::merit`); at the sharp level the fitness is the merit.
     #[serde(with = "exact::scalar", default = "unknown")]
     blurred_merit: f64,
-    /// Set once the run found its sharp columns to be noise (it then went
+    /// Set once the run found a sharp column to be noise (it then went
     /// coarse, and does not again).
     #[serde(default)]
     pub rough: bool,
@@ -381,7 +381,7 @@ impl Local {
         self.probe = Probe::Jacobian;
     }
 
-    /// After a sharp Jacobian: when its resolved columns are noise
+    /// After a sharp Jacobian: when one of its resolved columns is noise
     /// (`pyramid::rough`) and the run has not been coarse yet, it goes to
     /// the coarsest level; returns whether it did.
     fn coarsen(&mut self, evaluations: &[Evaluation]) -> bool {
