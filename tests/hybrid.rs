@@ -414,7 +414,10 @@ fn a_damaged_hybrid_state_is_refused_on_loading() {
 
 #[test]
 fn a_finished_local_run_hands_its_point_back_to_the_global_phase() {
-    let problem = Blobs::new(&blob_truth());
+    // Noisy, so that no run fits exactly: a population whose local run
+    // ends at a deviation of 0 is done, and is redrawn for a second
+    // opinion (a restart) instead of taking the point back.
+    let problem = Blobs::noisy(&blob_truth(), 4.0, 7);
     let mut search = Searcher::new(12, &config(Strategy::Hybrid, 3), Start::Uniform);
     let mut was_local = false;
     let mut at_handover = f64::INFINITY;
@@ -436,6 +439,10 @@ fn a_finished_local_run_hands_its_point_back_to_the_global_phase() {
         assert!(search.evaluations() < 60_000, "never went back to SHADE");
     }
     let (population, fitness) = search.population().expect("global phase again");
+    assert!(
+        fitness.iter().any(|f| f.is_finite()),
+        "the population was redrawn (a restart), not handed the point"
+    );
     let (best, best_fitness) = search.best();
     assert!(best_fitness < at_handover, "the local run found nothing");
     let held = population
