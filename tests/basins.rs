@@ -4,8 +4,10 @@
 //! render, so its values are the hidden truth):
 //! - a dark ball with a mirror-like highlight (shininess 20,000) of a few
 //!   pixels: the default search ends with the light within 1 degree;
-//! - two lights whose swap renders the same image: when a run reports
-//!   `alternatives`, each is the swap, and over a few seeds some run does;
+//! - two lights whose swap renders the same image: every run reports the
+//!   swap as its one alternative (the search renders the swapped end of
+//!   its descents, `optimize/swaps.rs`), not only the runs whose restarts
+//!   happened to land in both basins;
 //! - one light free: no run reports `alternatives` (the key is absent);
 //! - the report shows an ambiguous run's alternatives side by side.
 //!
@@ -85,7 +87,6 @@ fn a_mirror_like_highlight_is_found_within_a_degree() {
 #[test]
 fn swapped_lights_are_reported_as_alternatives() {
     let dir = tempfile::tempdir().unwrap();
-    let mut reported = 0;
     for seed in 1..=6 {
         let (result, truth) = fit(dir.path(), "two_lights", seed);
         let (a, b) = (
@@ -94,15 +95,10 @@ fn swapped_lights_are_reported_as_alternatives() {
         );
         let fitted_a = &result["params"]["lights.a.direction"];
         let swapped = |x: &serde_json::Value| angle(x, b) < 2.0;
-        let Some(alternatives) = result.get("alternatives") else {
-            continue;
-        };
-        let alternatives = alternatives.as_array().unwrap();
-        assert!(
-            !alternatives.is_empty(),
-            "seed {seed}: an empty list is absent"
-        );
-        reported += 1;
+        let alternatives = result["alternatives"].as_array();
+        let alternatives = alternatives.unwrap_or_else(|| panic!("seed {seed}: no alternatives"));
+        // Two lengths of one swapped direction are one answer.
+        assert_eq!(alternatives.len(), 1, "seed {seed}: {alternatives:?}");
         let deviation = result["deviation"]["average"].as_f64().unwrap();
         for alt in alternatives {
             let other_a = &alt["params"]["lights.a.direction"];
@@ -120,7 +116,6 @@ fn swapped_lights_are_reported_as_alternatives() {
             );
         }
     }
-    assert!(reported > 0, "no seed of 1..=6 reported the swap");
 }
 
 #[test]

@@ -20,6 +20,7 @@ mod output;
 mod problem;
 mod search_run;
 pub mod set;
+mod swaps;
 mod target;
 pub(crate) mod uncertainty;
 

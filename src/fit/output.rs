@@ -68,19 +68,26 @@ pub struct Alternative {
 
 /// The search's alternatives (unit points and fitness, best first) as
 /// result.json's entries, keeping only those whose scene values differ
-/// from the best's by more than `optimize::basins::SEPARATION` of a
-/// parameter's range: a light's direction compared as a direction (its
-/// length changes nothing), a colour searched in HSV as RGB (a black
-/// ball's hue changes nothing).
+/// from the best's, and from every better alternative kept, by more than
+/// `optimize::basins::SEPARATION` of a parameter's range: a light's
+/// direction compared as a direction (its length changes nothing; two
+/// lengths of one swapped direction are one answer), a colour searched in
+/// HSV as RGB (a black ball's hue changes nothing).
 pub fn alternatives(
     space: &ParamSpace,
     base: &Scene,
     best: &[f64],
     found: &[(Vec<f64>, f64)],
 ) -> Vec<Alternative> {
-    found
-        .iter()
-        .filter(|(u, _)| answer_distance(space, best, u) > crate::optimize::basins::SEPARATION)
+    let far =
+        |a: &[f64], b: &[f64]| answer_distance(space, a, b) > crate::optimize::basins::SEPARATION;
+    let mut kept: Vec<&(Vec<f64>, f64)> = Vec::new();
+    for f in found {
+        if far(best, &f.0) && kept.iter().all(|k| far(&k.0, &f.0)) {
+            kept.push(f);
+        }
+    }
+    kept.into_iter()
         .map(|(u, fitness)| Alternative {
             params: space.json_values(&space.scene_at(base, u)),
             // The fitness is the sum of the three channels' deviations.

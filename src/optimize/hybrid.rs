@@ -96,6 +96,7 @@ use super::basins::{alike, Basins};
 use super::identifiability::Identifiability;
 use super::lm::Normal;
 use super::local::Local;
+use super::swaps::Swaps;
 use super::{exact, De, DeConfig, Evaluation, Progress, Request, Search, Strategy};
 
 /// Hand over when the largest per-coordinate spread is below
@@ -194,6 +195,10 @@ pub struct Hybrid {
     /// Local runs of earlier populations.
     #[serde(default)]
     earlier_local_runs: usize,
+    /// Declared interchangeable coordinates and the swapped points
+    /// awaiting a render (`swaps.rs`).
+    #[serde(default)]
+    swaps: Swaps,
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -294,6 +299,7 @@ impl Hybrid {
             basins: Basins::default(),
             population_ends: Vec::new(),
             earlier_local_runs: 0,
+            swaps: Swaps::default(),
         }
     }
 
@@ -306,6 +312,14 @@ impl Hybrid {
         if periods.len() == self.dim {
             self.periods = periods;
         }
+    }
+
+    /// Declares coordinate permutations that may render the same image
+    /// (see `swaps.rs`): where a local run ends alike the best, its
+    /// swapped points are rendered too and may be reported as
+    /// alternatives.
+    pub fn set_swaps(&mut self, perms: Vec<Vec<usize>>) {
+        self.swaps.declare(self.dim, perms);
     }
 
     /// Ends the run once it has settled (see the module docs) rather than
@@ -486,6 +500,16 @@ impl Hybrid {
             .cloned()
     }
 
+    /// The swapped points rendered: each is a place seen (and the best,
+    /// if better); the phase goes on where it was.
+    fn tell_swaps(&mut self, evaluations: &[Evaluation]) {
+        for (point, e) in self.swaps.take().iter().zip(evaluations) {
+            self.observe(point, e.fitness);
+            self.basins.offer(point, e.fitness, self.best_fitness);
+        }
+        self.progress.observe(self.generation, self.best_fitness);
+    }
+
     fn tell_local(&mut self, mut local: Local, evaluations: &[Evaluation]) {
         self.generation += 1;
         // A trial better than the best counts at once: the target may be
@@ -518,6 +542,9 @@ impl Hybrid {
         self.ends.push(local.x.clone());
         self.basins
             .offer(&local.x, local.fitness, self.best_fitness);
+        if alike(self.best_fitness, local.fitness) {
+            self.swaps.queue_from(&local.x);
+        }
         let gained = local.fitness < local.start_fitness;
         self.global.inject(&local.x, local.fitness);
         let stuck = !gained && collapsed(self.global.population(), self.global.fitness());
@@ -573,6 +600,7 @@ impl Hybrid {
             && (self.periods.is_empty() || self.periods.len() == dim)
             && self.starts.iter().chain(&self.ends).all(|s| s.len() == dim)
             && self.basins.fits(dim)
+            && self.swaps.fits(dim)
             && self.at_best.as_ref().is_none_or(normal_ok);
         if let Phase::Local(local) = &self.phase {
             ok &= local.fits(dim) && local.normal.as_ref().is_none_or(normal_ok);
@@ -587,6 +615,13 @@ impl Hybrid {
 
 impl Search for Hybrid {
     fn ask(&mut self) -> Request {
+        if let Some(points) = self.swaps.pending() {
+            return Request {
+                points: points.to_vec(),
+                residuals: false,
+                blur: 0.0,
+            };
+        }
         match &mut self.phase {
             Phase::Global => Search::ask(&mut self.global),
             Phase::Local(local) => Request {
@@ -608,6 +643,7 @@ impl Search for Hybrid {
     /// If `evaluations` does not match the last request's length.
     fn tell(&mut self, evaluations: &[Evaluation]) {
         let expected = match &self.phase {
+            _ if self.swaps.pending().is_some() => self.swaps.pending().map_or(0, <[_]>::len),
             Phase::Global => self.global.population().len(),
             Phase::Local(local) => local.batch().len(),
             Phase::Done => 1,
@@ -619,6 +655,10 @@ impl Search for Hybrid {
             evaluations.len()
         );
         self.evaluations += evaluations.len();
+        if self.swaps.pending().is_some() {
+            self.tell_swaps(evaluations);
+            return;
+        }
         match std::mem::replace(&mut self.phase, Phase::Done) {
             Phase::Global => {
                 self.phase = Phase::Global;
@@ -647,7 +687,7 @@ impl Search for Hybrid {
     }
 
     fn converged(&self) -> bool {
-        matches!(self.phase, Phase::Done)
+        matches!(self.phase, Phase::Done) && self.swaps.pending().is_none()
     }
 
     fn population(&self) -> Option<(&[Vec<f64>], &[f64])> {

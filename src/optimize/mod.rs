@@ -50,6 +50,7 @@ mod searcher;
 mod shade;
 mod stop;
 mod strategy;
+mod swaps;
 
 pub use config::{ConfigError, DeConfig, MIN_POPULATION};
 pub use de::{De, TellError};

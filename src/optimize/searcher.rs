@@ -94,6 +94,14 @@ impl Searcher {
         }
     }
 
+    /// Declares coordinate swaps for a hybrid search
+    /// ([`Hybrid::set_swaps`]); a DE search is left as it is.
+    pub fn set_swaps(&mut self, perms: Vec<Vec<usize>>) {
+        if let Searcher::Hybrid(h) = self {
+            h.set_swaps(perms);
+        }
+    }
+
     /// The strategy this search runs.
     pub fn strategy(&self) -> Strategy {
         match self {

@@ -221,6 +221,7 @@ fn new_search(config: &FitConfig, sub: &ParamSpace, base: &Scene, phase_index: u
     };
     let mut search = Searcher::new(sub.dim(), &de, start);
     search.set_periods(periods(sub));
+    search.set_swaps(crate::fit::swaps::light_swaps(sub, base));
     if config.settle {
         search.settle();
     }
