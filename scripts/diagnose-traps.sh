@@ -19,7 +19,7 @@ bin=$(realpath "${3:-target/release/scenefit}")
 root=$(pwd)
 started=$(date +%s)
 TRAPS_DIR="$out" TRAPS_N="$n" cargo test --release --test diagnose_traps -q -- --ignored write_trap_sets >/dev/null
-err() { python3 "$root/scripts/light-error.py" "$1" lights.txt | awk '{print $2}'; }
+err() { python3 "$root/scripts/light-error.py" "$1" lights.txt | awk 'NR == 1 {print $2}'; }
 : >"$out/summary.tsv"
 for kind in trap lobe; do
   for ((i = 0; i < n; i++)); do

@@ -93,4 +93,5 @@ def main():
     print(f"map {w}x{h}: {count} texels solved, mean absolute error {err / max(count, 1):.4f} (linear)")
 
 
-main()
+if __name__ == "__main__":  # image-deviation.py imports read_png
+    main()
