@@ -41,14 +41,11 @@ fn with_maps(scene: &Scene, maps: &[(usize, TextureRef)]) -> Scene {
     s
 }
 
-/// The map file of object `object` in round `round` (`first`: before the
-/// refit) at side `side` (each side its own file: texels are read once per
+/// The map file of object `object` at side `side` for the solve `tag`
+/// names (each solve and side its own file: texels are read once per
 /// process and path).
-fn map_path(out: &Path, round: usize, first: bool, object: usize, side: u32) -> PathBuf {
-    let stage = if first { "_first" } else { "" };
-    let p = out.join(format!(
-        "albedo_map_round{round}{stage}_object{object}_side{side}.png"
-    ));
+fn map_path(out: &Path, tag: &str, object: usize, side: u32) -> PathBuf {
+    let p = out.join(format!("albedo_map_{tag}_object{object}_side{side}.png"));
     std::path::absolute(&p).unwrap_or(p)
 }
 
@@ -146,8 +143,9 @@ fn solve_for(
     fits: &mut Refits,
     scene: &Scene,
     own: &[Params],
-    (round, first): (usize, bool),
-) -> Result<Option<(Scene, usize)>> {
+    tag: &str,
+    at: Option<&[Option<Layout>]>,
+) -> Result<Option<Solved>> {
     let covered = covered(scene);
     let evidence = evidence(fits, scene, own, &covered)?;
     let inside: Vec<_> = evidence
@@ -159,20 +157,24 @@ fn solve_for(
         .collect();
     let ceiling = layouts(scene, &covered, &inside, fits.config.map_size);
     let written = |fits: &mut Refits, layouts: &[Option<Layout>]| {
-        written_maps(fits, scene, &evidence, layouts, (round, first))
+        let maps = written_maps(fits, scene, &evidence, layouts, tag)?;
+        Ok::<_, Error>(maps.map(|(s, count)| (s, count, layouts.to_vec())))
     };
+    if let Some(at) = at {
+        return written(fits, at);
+    }
     if fits.config.map_size.is_some() {
         return written(fits, &ceiling);
     }
     let (n, sad0) = texels::totals(&evidence);
-    let mut best: Option<(f64, Scene, usize)> = None;
+    let mut best: Option<(f64, Solved)> = None;
     let mut c = None;
     for shift in 0..=MAX_MAP_SIDE.trailing_zeros() {
         let sides = coarser(&ceiling, shift);
         if shift > 0 && sides == coarser(&ceiling, shift - 1) {
             break;
         }
-        let Some((s, count)) = written(fits, &sides)? else {
+        let Some((s, count, _)) = written(fits, &sides)? else {
             break;
         };
         let Some(m) = fits.model_of(s.clone(), own)? else {
@@ -192,10 +194,14 @@ fn solve_for(
         if best.as_ref().is_some_and(|b| score >= b.0) {
             break;
         }
-        best = Some((score, s, count));
+        best = Some((score, (s, count, sides)));
     }
-    Ok(best.map(|(_, s, count)| (s, count)))
+    Ok(best.map(|(_, solved)| solved))
 }
+
+/// A solve's result: the scene naming the maps, the values solved, and
+/// the layouts they were solved at.
+type Solved = (Scene, usize, Vec<Option<Layout>>);
 
 /// `ceiling` with every side shifted down by `shift` (at least 1).
 fn coarser(ceiling: &[Option<Layout>], shift: u32) -> Vec<Option<Layout>> {
@@ -218,7 +224,7 @@ fn written_maps(
     scene: &Scene,
     evidence: &[Evidence],
     layouts: &[Option<Layout>],
-    (round, first): (usize, bool),
+    tag: &str,
 ) -> Result<Option<(Scene, usize)>> {
     let solved = texels::solve(evidence, layouts, scene.camera.response);
     if solved.is_empty() {
@@ -226,7 +232,7 @@ fn written_maps(
     }
     let mut refs = Vec::new();
     for map in &solved {
-        let path = map_path(fits.out, round, first, map.object, map.layout.side);
+        let path = map_path(fits.out, tag, map.object, map.layout.side);
         refs.push((map.object, super::map_file::write(&path, map)?));
     }
     let count = solved.iter().map(|m| m.count).sum();
@@ -241,7 +247,8 @@ pub(super) fn solved(
     model: &Model,
     round: usize,
 ) -> Result<Option<(Model, usize)>> {
-    let Some((scene, count1)) = solve_for(fits, &model.scene, &model.own, (round, true))? else {
+    let first = format!("round{round}_first");
+    let Some((scene, count1, _)) = solve_for(fits, &model.scene, &model.own, &first, None)? else {
         return Ok(None);
     };
     // The losing map stays on disk until the diagnosis prunes every map
@@ -250,7 +257,8 @@ pub(super) fn solved(
     // Solved again on the refitted model without the first map: the
     // objects it covered are covered again.
     let bare = without_maps(&fitted.scene, &scene, &model.scene);
-    if let Some((again, count2)) = solve_for(fits, &bare, &fitted.own, (round, false))? {
+    let again = solve_for(fits, &bare, &fitted.own, &format!("round{round}"), None)?;
+    if let Some((again, count2, _)) = again {
         let own = fitted.own.clone();
         if let Some(m) = fits.model_of(again, &own)? {
             if m.sad < fitted.sad {
@@ -259,6 +267,23 @@ pub(super) fn solved(
         }
     }
     Ok(Some((fitted, count)))
+}
+
+/// `model` with the maps solved for it as it stands (no refit), the files
+/// named by `tag`: the model without the albedo's part of its residual
+/// (`footing.rs`), and the layouts solved at — `at` when given (so two
+/// models are compared with the same map), else the side the criterion
+/// keeps. None: no value could be solved.
+pub(super) fn texture_free(
+    fits: &mut Refits,
+    model: &Model,
+    tag: &str,
+    at: Option<&[Option<Layout>]>,
+) -> Result<Option<(Model, Vec<Option<Layout>>)>> {
+    let Some((scene, _, layouts)) = solve_for(fits, &model.scene, &model.own, tag, at)? else {
+        return Ok(None);
+    };
+    Ok(fits.model_of(scene, &model.own)?.map(|m| (m, layouts)))
 }
 
 /// `scene` with the colour maps that `with` added to `without` removed.

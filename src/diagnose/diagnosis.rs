@@ -26,6 +26,26 @@ pub struct Candidate {
     pub accepted: bool,
     /// Which refit counted: "warm" or "from scratch".
     pub refit: String,
+    /// A set's candidate weighed on the residual without the albedo's
+    /// part as well (`footing.rs`); `delta_bic`, `gain` and
+    /// `overdispersion` are the footing's that `counted` names.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub footing: Option<Footing>,
+}
+
+/// A candidate weighed twice: on the residual as it is, and with a colour
+/// map solved for the model before and after it (diagnosis.json's
+/// `footing`).
+#[derive(Clone, Debug, Serialize)]
+pub struct Footing {
+    /// "plain" or "texture-free": the footing whose criterion is lower.
+    pub counted: &'static str,
+    pub plain_delta_bic: f64,
+    pub plain_gain: f64,
+    pub texture_free_delta_bic: f64,
+    pub texture_free_gain: f64,
+    /// ĉ of the texture-free footing's residuals.
+    pub texture_free_overdispersion: f64,
 }
 
 /// diagnosis.json.

@@ -29,6 +29,7 @@ mod config;
 mod diagnosis;
 pub mod effects;
 pub mod features;
+mod footing;
 mod held;
 mod imitations;
 mod inputs;

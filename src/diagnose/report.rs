@@ -231,6 +231,7 @@ mod tests {
             added_params: 1,
             accepted: true,
             refit: "from scratch".into(),
+            footing: None,
         };
         let mut params = serde_json::Map::new();
         params.insert("camera.vignetting.strength".into(), serde_json::json!(0.4));

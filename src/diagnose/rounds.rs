@@ -109,6 +109,7 @@ fn round_of(
             added_params: (fitted.dim(inputs) + values).saturating_sub(k0),
             accepted: false,
             refit: refit.into(),
+            footing: None,
         };
         tried.push((candidate, (fitted, Step { effect, form })));
     }
@@ -116,6 +117,7 @@ fn round_of(
     let (mut found, models): (Vec<Candidate>, Vec<(Model, Step)>) = tried.into_iter().unzip();
     let (models, steps): (Vec<Model>, Vec<Step>) = models.into_iter().unzip();
     weigh_round(&mut found, &models, model.sad, n, inputs);
+    super::footing::weigh_texture_free(fits, model, &mut found, &models, n, round)?;
     let chosen = choose(&found, fits.config);
     let named = chosen.map_or_else(Vec::new, |i| {
         imitations_of(&found, i, &models, model, inputs)

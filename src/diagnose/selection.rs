@@ -159,6 +159,7 @@ mod tests {
             added_params: 1,
             accepted: false,
             refit: "warm".into(),
+            footing: None,
         }
     }
 
