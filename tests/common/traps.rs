@@ -32,15 +32,29 @@ pub enum Kind {
 /// Image side, pixels: small, so that a set's diagnosis is cheap.
 pub const SIDE: u32 = 64;
 
+/// How large a set is: its images' side and its number of photographs.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Size {
+    pub side: u32,
+    /// The photographs (one light each); None: 8–12, drawn with the seed.
+    pub lights: Option<usize>,
+}
+
+/// The sets scripts/diagnose-traps.sh runs.
+pub const FULL: Size = Size {
+    side: SIDE,
+    lights: None,
+};
+
 /// The ball's radius and the camera's frame height.
 const RADIUS: f64 = 0.5;
 const FRAME: f64 = 1.2;
 
 /// The scene of one photograph, `light` its (direction, intensity).
-fn scene_json(material: Value, light: ([f64; 3], f64), response: Option<f64>) -> Value {
+fn scene_json(material: Value, light: ([f64; 3], f64), response: Option<f64>, side: u32) -> Value {
     let mut s = json!({
         "format": "scenefit-scene/1",
-        "image": {"width": SIDE, "height": SIDE},
+        "image": {"width": side, "height": side},
         "camera": {"type": "orthographic", "position": [0, 0, 5], "look_at": [0, 0, 0],
                    "up": [0, 1, 0], "height": FRAME},
         "ambient": [0.0, 0.0, 0.0],
@@ -59,9 +73,10 @@ fn scene_json(material: Value, light: ([f64; 3], f64), response: Option<f64>) ->
 }
 
 /// A smooth painted albedo: per channel, 1 ± 0.25 over one or two waves
-/// across the image, at seeded frequencies and phases.
-fn painted(rng: &mut rand::rngs::StdRng) -> AlbedoMap {
-    let mut m = AlbedoMap::uniform(SIDE, SIDE, 1.0);
+/// across the image, at seeded frequencies and phases (the same pattern
+/// at any `side`: it is the image's, in pixels of that side).
+fn painted(rng: &mut rand::rngs::StdRng, side: u32) -> AlbedoMap {
+    let mut m = AlbedoMap::uniform(side, side, 1.0);
     let waves: Vec<[f64; 5]> = (0..3)
         .map(|_| {
             [
@@ -73,22 +88,26 @@ fn painted(rng: &mut rand::rngs::StdRng) -> AlbedoMap {
             ]
         })
         .collect();
-    for y in 0..SIDE as usize {
-        for x in 0..SIDE as usize {
-            let (u, v) = (x as f64 / SIDE as f64, y as f64 / SIDE as f64);
+    let n = side as usize;
+    for y in 0..n {
+        for x in 0..n {
+            let (u, v) = (x as f64 / n as f64, y as f64 / n as f64);
             for (c, w) in waves.iter().enumerate() {
                 let a = (TAU * w[1] * u + w[3]).sin() * (TAU * w[2] * v + w[4]).cos();
-                m.values[3 * (y * SIDE as usize + x) + c] = (1.0 + w[0] * a) as f32;
+                m.values[3 * (y * n + x) + c] = (1.0 + w[0] * a) as f32;
             }
         }
     }
     m
 }
 
-/// 8–12 lights spread around the view axis, 10°–50° from it, with
-/// intensities that keep the brightest linear value below 1.
-fn lights(rng: &mut rand::rngs::StdRng) -> Vec<([f64; 3], f64)> {
-    let n = rng.gen_range(8..=12);
+/// 8–12 lights (`count` when given) spread around the view axis, 10°–50°
+/// from it, with intensities that keep the brightest linear value below 1.
+fn lights(rng: &mut rand::rngs::StdRng, count: Option<usize>) -> Vec<([f64; 3], f64)> {
+    // Drawn even when `count` is given, so that the rest of the set is
+    // drawn from the same stream.
+    let drawn = rng.gen_range(8..=12);
+    let n = count.unwrap_or(drawn);
     let turn = rng.gen_range(0.0..TAU);
     (0..n)
         .map(|i| {
@@ -106,9 +125,9 @@ fn lights(rng: &mut rand::rngs::StdRng) -> Vec<([f64; 3], f64)> {
 
 /// The ball's mask, a pixel inside when its centre is 1.5 pixels within
 /// the silhouette (as a photograph's mask is drawn inside the edge).
-fn mask() -> scenefit::raster::Image {
-    let px = FRAME / SIDE as f64;
-    scenefit::raster::Image::from_fn(SIDE, SIDE, |x, y| {
+fn mask(side: u32) -> scenefit::raster::Image {
+    let px = FRAME / side as f64;
+    scenefit::raster::Image::from_fn(side, side, |x, y| {
         let u = (x as f64 + 0.5) * px - FRAME / 2.0;
         let v = (y as f64 + 0.5) * px - FRAME / 2.0;
         let inside = (u * u + v * v).sqrt() < RADIUS - 1.5 * px;
@@ -122,13 +141,18 @@ fn mask() -> scenefit::raster::Image {
 /// (the model), `declared.json` (the model with the files' encoding
 /// declared), `shots.json` and `lights.txt`.
 pub fn write(dir: &Path, kind: Kind, seed: u64) {
+    write_sized(dir, kind, seed, FULL);
+}
+
+/// [`write`] at `size`.
+pub fn write_sized(dir: &Path, kind: Kind, seed: u64, size: Size) {
     std::fs::create_dir_all(dir).unwrap();
     let mut rng = rand::rngs::StdRng::seed_from_u64(seed);
-    let map = painted(&mut rng);
+    let map = painted(&mut rng, size.side);
     let map_path = std::path::absolute(dir.join("albedo.exr")).unwrap();
     albedo_map::write(&map_path, map).unwrap();
     let color: Vec<f64> = (0..3).map(|_| rng.gen_range(0.45..0.75)).collect();
-    let lights = lights(&mut rng);
+    let lights = lights(&mut rng, size.lights);
     let (material, response) = match kind {
         Kind::Matte { gamma } => (
             json!({"color": color, "diffuse": 1.0, "specular": 0.0}),
@@ -145,9 +169,9 @@ pub fn write(dir: &Path, kind: Kind, seed: u64) {
     let phong = from_spec("phong").unwrap();
     let mut shots = Vec::new();
     let mut truth = String::new();
-    scenefit::raster::io::write_image(&mask(), &dir.join("mask.png")).unwrap();
+    scenefit::raster::io::write_image(&mask(size.side), &dir.join("mask.png")).unwrap();
     for (i, &light) in lights.iter().enumerate() {
-        let s = scene_json(material.clone(), light, response);
+        let s = scene_json(material.clone(), light, response, size.side);
         let scene = scenefit::scene::load::from_value(s, "trap.json").unwrap();
         let img = render_one(phong.as_ref(), &scene, 0).unwrap();
         let name = format!("s{i}");
@@ -159,19 +183,20 @@ pub fn write(dir: &Path, kind: Kind, seed: u64) {
     std::fs::write(dir.join("lights.txt"), truth).unwrap();
     let shots = json!({"format": "scenefit-shots/1", "shots": shots});
     std::fs::write(dir.join("shots.json"), shots.to_string()).unwrap();
-    let user = model(None);
+    let user = model(None, size.side);
     std::fs::write(dir.join("scene.json"), user.to_string()).unwrap();
-    std::fs::write(dir.join("declared.json"), model(response).to_string()).unwrap();
+    let declared = model(response, size.side);
+    std::fs::write(dir.join("declared.json"), declared.to_string()).unwrap();
 }
 
 /// The scene a user writes for such a set: one light whose direction and
 /// intensity each photograph has its own of, the material's colour,
 /// specular strength and shininess shared and free; `response` a gamma
 /// the files are declared to hold (None: nothing declared).
-fn model(response: Option<f64>) -> Value {
+fn model(response: Option<f64>, side: u32) -> Value {
     let material = json!({"color": [0.5, 0.5, 0.5], "diffuse": 1.0, "specular": 0.3,
                           "shininess": 30.0});
-    let mut s = scene_json(material, ([0.0, 0.0, 1.0], 3.0), response);
+    let mut s = scene_json(material, ([0.0, 0.0, 1.0], 3.0), response, side);
     s["free"] = json!([
         {"param": "lights.led.direction", "min": [-1, -1, 0.05], "max": [1, 1, 1], "per_shot": true},
         {"param": "lights.led.intensity", "min": 0.01, "max": 20, "per_shot": true},
