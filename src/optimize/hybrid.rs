@@ -470,9 +470,6 @@ impl Hybrid {
             rate,
             global_done,
             &self.periods,
-            // Each run goes coarse on its own evidence (see the module
-            // docs).
-            0.0,
         ));
         self.starts.push(start);
     }
@@ -642,11 +639,15 @@ impl Search for Hybrid {
     /// # Panics
     /// If `evaluations` does not match the last request's length.
     fn tell(&mut self, evaluations: &[Evaluation]) {
-        let expected = match &self.phase {
-            _ if self.swaps.pending().is_some() => self.swaps.pending().map_or(0, <[_]>::len),
-            Phase::Global => self.global.population().len(),
-            Phase::Local(local) => local.batch().len(),
-            Phase::Done => 1,
+        // The swapped ends, while pending, are what `ask` requested.
+        let expected = if let Some(points) = self.swaps.pending() {
+            points.len()
+        } else {
+            match &self.phase {
+                Phase::Global => self.global.population().len(),
+                Phase::Local(local) => local.batch().len(),
+                Phase::Done => 1,
+            }
         };
         assert_eq!(
             evaluations.len(),

@@ -133,15 +133,14 @@ fn unknown() -> f64 {
 }
 
 impl Local {
-    /// A run from `x`; `blur` > 0 starts it coarse (a landscape already
-    /// known to be rough), at that level.
+    /// A run from `x`, sharp: it goes coarse only on its own evidence
+    /// (see the module docs).
     pub fn start(
         x: &[f64],
         steps: Vec<f64>,
         rate_floor: f64,
         global_done: bool,
         periods: &[f64],
-        blur: f64,
     ) -> Local {
         // The same image, farther from the faces (see `lm::wrap`).
         let x = lm::wrap(x, periods);
@@ -163,9 +162,9 @@ impl Local {
             outpaced: false,
             global_done,
             periods: periods.to_vec(),
-            blur,
+            blur: 0.0,
             blurred_merit: f64::INFINITY,
-            rough: blur > 0.0,
+            rough: false,
         }
     }
 
