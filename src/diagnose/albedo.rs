@@ -20,7 +20,7 @@ use super::effects::covered;
 use super::inputs::Params;
 use super::model::{shots_of, Model};
 use super::refits::Refits;
-use super::selection::{delta_bic, overdispersion};
+use super::selection::{delta_bic, overdispersion_of};
 use super::texel_layout::{layouts, Layout, MAX_MAP_SIDE};
 use super::texels::{self, Evidence};
 use crate::error::{Error, Result};
@@ -182,14 +182,7 @@ fn solve_for(
         };
         // One overdispersion for every side, the finest's: the most general
         // model tried, as the round weighs its candidates (`selection::weigh`).
-        let c = *c.get_or_insert_with(|| {
-            overdispersion(
-                m.images
-                    .iter()
-                    .zip(&fits.inputs.shots)
-                    .map(|(img, shot)| (&shot.target.image, img, shot.target.mask.as_ref())),
-            )
-        });
+        let c = *c.get_or_insert_with(|| overdispersion_of(&m, fits.inputs));
         let score = delta_bic(sad0, m.sad, n, count, c);
         if best.as_ref().is_some_and(|b| score >= b.0) {
             break;

@@ -27,7 +27,7 @@ use super::effects;
 use super::model::Model;
 use super::refits::Refits;
 use super::schedule::Schedule;
-use super::selection::{delta_bic, overdispersion};
+use super::selection::{delta_bic, overdispersion_of};
 use super::Candidate;
 use crate::error::Result;
 
@@ -70,7 +70,7 @@ pub(super) fn weigh_texture_free(
     let Some(general) = general else {
         return Ok(());
     };
-    let c = overdispersion_of(general, fits);
+    let c = overdispersion_of(general, fits.inputs);
     for (cand, m) in found.iter_mut().zip(&mapped) {
         let Some(m) = m else { continue };
         let (plain_delta_bic, plain_gain) =
@@ -93,10 +93,4 @@ pub(super) fn weigh_texture_free(
         });
     }
     Ok(())
-}
-
-/// ĉ of `model`'s residuals over every photograph.
-fn overdispersion_of(model: &Model, fits: &Refits) -> f64 {
-    let pairs = model.images.iter().zip(&fits.inputs.shots);
-    overdispersion(pairs.map(|(img, s)| (&s.target.image, img, s.target.mask.as_ref())))
 }

@@ -16,7 +16,7 @@ use super::model::{weighted_mean, Model};
 use super::refits::Refits;
 use super::residual::Residual;
 use super::schedule::Refit;
-use super::selection::{choose, overdispersion, weigh};
+use super::selection::{choose, overdispersion_of, weigh};
 use super::trials::Trial;
 use super::Candidate;
 use crate::error::Result;
@@ -186,12 +186,6 @@ fn try_effects(
         }
     }
     Ok(best)
-}
-
-/// The overdispersion of `model`'s residuals over every photograph.
-fn overdispersion_of(model: &Model, inputs: &SetInputs) -> f64 {
-    let pairs = model.images.iter().zip(&inputs.shots);
-    overdispersion(pairs.map(|(img, s)| (&s.target.image, img, s.target.mask.as_ref())))
 }
 
 /// The effects of a round whose refits changed the renders as the

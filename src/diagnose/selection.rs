@@ -13,6 +13,8 @@
 //! is the BIC; on a smooth misfit it keeps a map of many values from
 //! being paid for by evidence counted once per pixel.
 
+use super::inputs::SetInputs;
+use super::model::Model;
 use super::{Candidate, DiagnoseConfig};
 use crate::metric::Mask;
 use crate::raster::Image;
@@ -120,6 +122,14 @@ pub fn overdispersion<'a>(
         (1.0 + r) / (1.0 - r)
     };
     inflation(sx / s0) * inflation(sy / s0)
+}
+
+/// ĉ of `model`'s residuals over every photograph of `inputs`: the one
+/// measure the rounds, the backward step, the footing and the map's sides
+/// all take, so that their criteria stay comparable.
+pub(super) fn overdispersion_of(model: &Model, inputs: &SetInputs) -> f64 {
+    let pairs = model.images.iter().zip(&inputs.shots);
+    overdispersion(pairs.map(|(img, s)| (&s.target.image, img, s.target.mask.as_ref())))
 }
 
 /// True when a candidate's refit earns its parameters: BIC lower by more
