@@ -87,13 +87,15 @@ pub fn prune(out: &Path, kept: &Scene) {
 }
 
 /// Each photograph's evidence for `scene` with its `own` values: its
-/// model rendered with the covered objects' colours as they are (`lit`)
-/// and at 0 (`dark`), and the surface pass of its camera.
+/// model rendered with the covered objects' colours as they are (`lit`:
+/// `held` when the caller already holds those renders) and at 0
+/// (`dark`), and the surface pass of its camera.
 fn evidence<'a>(
     fits: &mut Refits<'a>,
     scene: &Scene,
     own: &[Params],
     covered: &[bool],
+    held: Option<&[Image]>,
 ) -> Result<Vec<Evidence<'a>>> {
     let inputs = fits.inputs;
     let (zero_path, zero) = super::map_file::zero(fits.out)?;
@@ -109,7 +111,10 @@ fn evidence<'a>(
             .ok_or_else(|| Error::Run("albedo_map: a render of the photographs failed".into()))?;
         Ok((shots, images))
     };
-    let (shots, lit) = rendered(fits, scene)?;
+    let (shots, lit) = match held {
+        Some(images) => (shots_of(scene, inputs, own)?, images.to_vec()),
+        None => rendered(fits, scene)?,
+    };
     let dark = rendered(fits, &dark_scene);
     discard(&zero_path);
     let (_, dark) = dark?;
@@ -143,11 +148,12 @@ fn solve_for(
     fits: &mut Refits,
     scene: &Scene,
     own: &[Params],
+    held: Option<&[Image]>,
     tag: &str,
     at: Option<&[Option<Layout>]>,
 ) -> Result<Option<Solved>> {
     let covered = covered(scene);
-    let evidence = evidence(fits, scene, own, &covered)?;
+    let evidence = evidence(fits, scene, own, &covered, held)?;
     let inside: Vec<_> = evidence
         .iter()
         .map(|e| {
@@ -241,7 +247,10 @@ pub(super) fn solved(
     round: usize,
 ) -> Result<Option<(Model, usize)>> {
     let first = format!("round{round}_first");
-    let Some((scene, count1, _)) = solve_for(fits, &model.scene, &model.own, &first, None)? else {
+    // The model's renders are its lit evidence: not drawn again.
+    let held = Some(&model.images[..]);
+    let Some((scene, count1, _)) = solve_for(fits, &model.scene, &model.own, held, &first, None)?
+    else {
         return Ok(None);
     };
     // The losing map stays on disk until the diagnosis prunes every map
@@ -250,7 +259,14 @@ pub(super) fn solved(
     // Solved again on the refitted model without the first map: the
     // objects it covered are covered again.
     let bare = without_maps(&fitted.scene, &scene, &model.scene);
-    let again = solve_for(fits, &bare, &fitted.own, &format!("round{round}"), None)?;
+    let again = solve_for(
+        fits,
+        &bare,
+        &fitted.own,
+        None,
+        &format!("round{round}"),
+        None,
+    )?;
     if let Some((again, count2, _)) = again {
         let own = fitted.own.clone();
         if let Some(m) = fits.model_of(again, &own)? {
@@ -266,14 +282,17 @@ pub(super) fn solved(
 /// named by `tag`: the model without the albedo's part of its residual
 /// (`footing.rs`), and the layouts solved at — `at` when given (so two
 /// models are compared with the same map), else the side the criterion
-/// keeps. None: no value could be solved.
+/// keeps. None: no value could be solved. The model's renders are its
+/// lit evidence: they are not drawn again.
 pub(super) fn texture_free(
     fits: &mut Refits,
     model: &Model,
     tag: &str,
     at: Option<&[Option<Layout>]>,
 ) -> Result<Option<(Model, Vec<Option<Layout>>)>> {
-    let Some((scene, _, layouts)) = solve_for(fits, &model.scene, &model.own, tag, at)? else {
+    let held = Some(&model.images[..]);
+    let Some((scene, _, layouts)) = solve_for(fits, &model.scene, &model.own, held, tag, at)?
+    else {
         return Ok(None);
     };
     Ok(fits.model_of(scene, &model.own)?.map(|m| (m, layouts)))
