@@ -1,7 +1,9 @@
-//! The closed-form effect `albedo_map`: a colour texture in each object's
-//! frame (`material.color_map`), a multiplier of the diffuse colour per
-//! texel and channel, shared by every photograph and solved from all of
-//! them that see the texel, whatever the camera and light of each
+//! The closed-form effects `albedo_map` and `specular_map`: a colour
+//! texture in each object's frame (`material.color_map`), a multiplier of
+//! the diffuse colour per texel and channel, or a specular one
+//! (`material.specular_map`), a multiplier of the specular strength per
+//! texel, shared by every photograph and solved from all of them that see
+//! the texel, whatever the camera and light of each
 //! (`texels.rs`; the finest resolution the samples support in
 //! `texel_layout.rs`, the side kept chosen by the criterion in
 //! `solve_for`). No search could fit it. Values with evidence in fewer
@@ -14,7 +16,7 @@
 //! in the scene, and the map solved once more against the refitted model
 //! (the better of the two kept). Its parameters for the criterion are the
 //! values solved, ln N each. The maps are written into the diagnosis
-//! directory as 16-bit linear PNG (`map_file.rs`).
+//! directory as 16-bit linear PNG (`map_file.rs`, which names them).
 
 use super::effects::covered;
 use super::inputs::Params;
@@ -28,25 +30,17 @@ use crate::fit::set::shots::Shot;
 use crate::metric::Mask;
 use crate::raster::Image;
 use crate::render::surface_coords;
-use crate::scene::texture::TextureRef;
+use crate::scene::texture::{MapKind, TextureRef};
 use crate::scene::Scene;
 use std::path::{Path, PathBuf};
 
-/// `scene` with each `(object, map)` set as that object's colour map.
-fn with_maps(scene: &Scene, maps: &[(usize, TextureRef)]) -> Scene {
+/// `scene` with each `(object, map)` set as that object's map of `kind`.
+fn with_maps(scene: &Scene, maps: &[(usize, TextureRef)], kind: MapKind) -> Scene {
     let mut s = scene.clone();
     for (o, t) in maps {
-        s.objects[*o].material.color_map = Some(t.clone());
+        *s.objects[*o].material.map_slot(kind) = Some(t.clone());
     }
     s
-}
-
-/// The map file of object `object` at side `side` for the solve `tag`
-/// names (each solve and side its own file: texels are read once per
-/// process and path).
-fn map_path(out: &Path, tag: &str, object: usize, side: u32) -> PathBuf {
-    let p = out.join(format!("albedo_map_{tag}_object{object}_side{side}.png"));
-    std::path::absolute(&p).unwrap_or(p)
 }
 
 /// Removes the map file a model no longer names.
@@ -63,8 +57,9 @@ pub fn prune(out: &Path, kept: &Scene) {
         .iter()
         .flat_map(|o| {
             let m = &o.material;
-            let color = m.color_map.as_ref().map(|t| t.file().to_string());
-            [m.albedo_map.clone(), color]
+            let file = |t: Option<&TextureRef>| t.map(|t| t.file().to_string());
+            let color = file(m.color_map.as_ref());
+            [m.albedo_map.clone(), color, file(m.specular_map.as_ref())]
         })
         .flatten()
         .map(PathBuf::from)
@@ -74,8 +69,7 @@ pub fn prune(out: &Path, kept: &Scene) {
     };
     for e in entries.flatten() {
         let name = e.file_name().to_string_lossy().into_owned();
-        if !(name.starts_with("albedo_map_") && (name.ends_with(".exr") || name.ends_with(".png")))
-        {
+        if !super::map_file::is_map_file(&name) {
             continue;
         }
         let path = e.path();
@@ -87,28 +81,34 @@ pub fn prune(out: &Path, kept: &Scene) {
 }
 
 /// Each photograph's evidence for `scene` with its `own` values: its
-/// model rendered with the covered objects' colours as they are (`lit`:
-/// `held` when the caller already holds those renders) and at 0
-/// (`dark`), and the surface pass of its camera.
+/// model rendered with the covered objects' colours (or specular
+/// strengths, by `kind`) as they are (`lit`: `held` when the caller
+/// already holds those renders) and at 0 (`dark`), and the surface pass
+/// of its camera.
 fn evidence<'a>(
     fits: &mut Refits<'a>,
     scene: &Scene,
     own: &[Params],
     covered: &[bool],
     held: Option<&[Image]>,
+    kind: MapKind,
 ) -> Result<Vec<Evidence<'a>>> {
     let inputs = fits.inputs;
-    let (zero_path, zero) = super::map_file::zero(fits.out)?;
+    let (zero_path, zero) = super::map_file::zero(fits.out, kind)?;
     let probe: Vec<(usize, TextureRef)> = (0..covered.len())
         .filter(|&o| covered[o])
         .map(|o| (o, zero.clone()))
         .collect();
-    let dark_scene = with_maps(scene, &probe);
+    let dark_scene = with_maps(scene, &probe, kind);
     let rendered = |fits: &mut Refits, s: &Scene| -> Result<(Vec<Shot>, Vec<Image>)> {
         let shots: Vec<Shot> = shots_of(s, inputs, own)?;
         let images = fits.render(&shots)?.map(|(images, _)| images);
-        let images = images
-            .ok_or_else(|| Error::Run("albedo_map: a render of the photographs failed".into()))?;
+        let images = images.ok_or_else(|| {
+            Error::Run(format!(
+                "{}: a render of the photographs failed",
+                kind.key()
+            ))
+        })?;
         Ok((shots, images))
     };
     let (shots, lit) = match held {
@@ -149,11 +149,11 @@ fn solve_for(
     scene: &Scene,
     own: &[Params],
     held: Option<&[Image]>,
-    tag: &str,
+    (kind, tag): (MapKind, &str),
     at: Option<&[Option<Layout>]>,
 ) -> Result<Option<Solved>> {
-    let covered = covered(scene);
-    let evidence = evidence(fits, scene, own, &covered, held)?;
+    let covered = covered(scene, kind);
+    let evidence = evidence(fits, scene, own, &covered, held, kind)?;
     let inside: Vec<_> = evidence
         .iter()
         .map(|e| {
@@ -163,7 +163,7 @@ fn solve_for(
         .collect();
     let ceiling = layouts(scene, &covered, &inside, fits.config.map_size);
     let written = |fits: &mut Refits, layouts: &[Option<Layout>]| {
-        let maps = written_maps(fits, scene, &evidence, layouts, tag)?;
+        let maps = written_maps(fits, scene, &evidence, layouts, (kind, tag))?;
         Ok::<_, Error>(maps.map(|(s, count)| (s, count, layouts.to_vec())))
     };
     if let Some(at) = at {
@@ -223,34 +223,36 @@ fn written_maps(
     scene: &Scene,
     evidence: &[Evidence],
     layouts: &[Option<Layout>],
-    tag: &str,
+    (kind, tag): (MapKind, &str),
 ) -> Result<Option<(Scene, usize)>> {
-    let solved = texels::solve(evidence, layouts, scene.camera.response);
+    let solved = texels::solve(evidence, layouts, scene.camera.response, kind);
     if solved.is_empty() {
         return Ok(None);
     }
     let mut refs = Vec::new();
     for map in &solved {
-        let path = map_path(fits.out, tag, map.object, map.layout.side);
+        let path = super::map_file::path(fits.out, kind, tag, map.object, map.layout.side);
         refs.push((map.object, super::map_file::write(&path, map)?));
     }
     let count = solved.iter().map(|m| m.count).sum();
-    Ok(Some((with_maps(scene, &refs), count)))
+    Ok(Some((with_maps(scene, &refs, kind), count)))
 }
 
-/// The model with `albedo_map`: solved, the others refitted
-/// (`Refits::after_solve`), solved again, the better of the two kept; the
-/// model and the values solved (None: nothing could be solved).
+/// The model with the maps of `kind` (`albedo_map`, `specular_map`):
+/// solved, the others refitted (`Refits::after_solve`), solved again, the
+/// better of the two kept; the model and the values solved (None: nothing
+/// could be solved).
 pub(super) fn solved(
     fits: &mut Refits,
     model: &Model,
     round: usize,
+    kind: MapKind,
 ) -> Result<Option<(Model, usize)>> {
     let first = format!("round{round}_first");
     // The model's renders are its lit evidence: not drawn again.
     let held = Some(&model.images[..]);
-    let Some((scene, count1, _)) = solve_for(fits, &model.scene, &model.own, held, &first, None)?
-    else {
+    let solve = solve_for(fits, &model.scene, &model.own, held, (kind, &first), None)?;
+    let Some((scene, count1, _)) = solve else {
         return Ok(None);
     };
     // The losing map stays on disk until the diagnosis prunes every map
@@ -258,15 +260,9 @@ pub(super) fn solved(
     let (mut fitted, mut count) = (fits.after_solve(&scene, &model.own)?, count1);
     // Solved again on the refitted model without the first map: the
     // objects it covered are covered again.
-    let bare = without_maps(&fitted.scene, &scene, &model.scene);
-    let again = solve_for(
-        fits,
-        &bare,
-        &fitted.own,
-        None,
-        &format!("round{round}"),
-        None,
-    )?;
+    let bare = without_maps(&fitted.scene, &scene, &model.scene, kind);
+    let tag = format!("round{round}");
+    let again = solve_for(fits, &bare, &fitted.own, None, (kind, &tag), None)?;
     if let Some((again, count2, _)) = again {
         let own = fitted.own.clone();
         if let Some(m) = fits.model_of(again, &own)? {
@@ -291,23 +287,24 @@ pub(super) fn texture_free(
     at: Option<&[Option<Layout>]>,
 ) -> Result<Option<(Model, Vec<Option<Layout>>)>> {
     let held = Some(&model.images[..]);
-    let Some((scene, _, layouts)) = solve_for(fits, &model.scene, &model.own, held, tag, at)?
+    let color = (MapKind::Color, tag);
+    let Some((scene, _, layouts)) = solve_for(fits, &model.scene, &model.own, held, color, at)?
     else {
         return Ok(None);
     };
     Ok(fits.model_of(scene, &model.own)?.map(|m| (m, layouts)))
 }
 
-/// `scene` with the colour maps that `with` added to `without` removed.
-fn without_maps(scene: &Scene, with: &Scene, without: &Scene) -> Scene {
+/// `scene` with the maps of `kind` that `with` added to `without` removed.
+fn without_maps(scene: &Scene, with: &Scene, without: &Scene, kind: MapKind) -> Scene {
     let mut s = scene.clone();
     for (o, (a, b)) in s
         .objects
         .iter_mut()
         .zip(with.objects.iter().zip(&without.objects))
     {
-        if a.material.color_map != b.material.color_map {
-            o.material.color_map = b.material.color_map.clone();
+        if a.material.map(kind) != b.material.map(kind) {
+            *o.material.map_slot(kind) = b.material.map(kind).cloned();
         }
     }
     s

@@ -29,12 +29,12 @@ pub struct Step {
 pub fn rebuild(base: &Scene, steps: &[Step], current: &Scene) -> Result<Scene> {
     let mut scene = base.clone();
     for step in steps {
-        if step.effect.closed_form() {
-            // The colour maps solved in closed form (`albedo.rs`), taken
-            // from the objects of `current` that `base` leaves unmapped.
+        if let Some(kind) = step.effect.map_kind() {
+            // The maps solved in closed form (`albedo.rs`), taken from the
+            // objects of `current` that `base` leaves unmapped.
             for (o, c) in scene.objects.iter_mut().zip(&current.objects) {
-                if o.material.color_map.is_none() {
-                    o.material.color_map = c.material.color_map.clone();
+                if o.material.map(kind).is_none() {
+                    *o.material.map_slot(kind) = c.material.map(kind).cloned();
                 }
             }
         } else if let Some(ext) = effects::forms(step.effect, &scene)

@@ -1,5 +1,6 @@
-//! The files of a colour texture the diagnosis solved (`texels.rs`):
-//! 16-bit PNG holding linear values, declared `"encoding": "linear"` with
+//! The files of a texture the diagnosis solved (`texels.rs`), a colour
+//! map or a specular one (grey: R = G = B), and the one owner of their
+//! names: 16-bit PNG holding linear values, declared `"encoding": "linear"` with
 //! a `range` of [0, the largest multiplier] (a stored value v means
 //! v × that maximum: a PNG holds [0, 1] only, a multiplier up to
 //! `texels::MAX_MULTIPLIER`), so every backend reads them as the built-in
@@ -8,7 +9,7 @@
 
 use super::texels::ObjectMap;
 use crate::error::{Error, Result};
-use crate::scene::texture::{Encoding, TextureRef, TextureSpec};
+use crate::scene::texture::{Encoding, MapKind, TextureRef, TextureSpec};
 use crate::scene::Scene;
 use std::path::{Path, PathBuf};
 
@@ -47,9 +48,37 @@ pub fn write(path: &Path, map: &ObjectMap) -> Result<TextureRef> {
     Ok(reference(path, map.layout.scale, hi))
 }
 
-/// Writes the zero map (one texel) into `out`; its reference.
-pub fn zero(out: &Path) -> Result<(PathBuf, TextureRef)> {
-    let path = out.join("albedo_map_zero.png");
+/// The prefix of every file of a map of `kind` the diagnosis writes: the
+/// effect's name.
+fn prefix(kind: MapKind) -> &'static str {
+    match kind {
+        MapKind::Specular => "specular_map_",
+        _ => "albedo_map_",
+    }
+}
+
+/// True when `name` is a map file the diagnosis writes (of any kind).
+pub fn is_map_file(name: &str) -> bool {
+    let ours = [MapKind::Color, MapKind::Specular]
+        .iter()
+        .any(|&k| name.starts_with(prefix(k)));
+    ours && (name.ends_with(".exr") || name.ends_with(".png"))
+}
+
+/// The file of object `object`'s map of `kind` at side `side` for the
+/// solve `tag` names, in `out` (each solve and side its own file: texels
+/// are read once per process and path).
+pub fn path(out: &Path, kind: MapKind, tag: &str, object: usize, side: u32) -> PathBuf {
+    let p = out.join(format!(
+        "{}{tag}_object{object}_side{side}.png",
+        prefix(kind)
+    ));
+    std::path::absolute(&p).unwrap_or(p)
+}
+
+/// Writes the zero map of `kind` (one texel) into `out`; its reference.
+pub fn zero(out: &Path, kind: MapKind) -> Result<(PathBuf, TextureRef)> {
+    let path = out.join(format!("{}zero.png", prefix(kind)));
     let path = std::path::absolute(&path).unwrap_or(path);
     write_png(&path, 1, vec![0; 3])?;
     let r = reference(&path, [1.0, 1.0], 1.0);
@@ -63,13 +92,15 @@ pub fn beside(scene: &Scene, out: &Path) -> Scene {
     let mut s = scene.clone();
     let out_abs = std::path::absolute(out).unwrap_or(out.to_path_buf());
     for o in &mut s.objects {
-        let Some(t) = o.material.color_map.as_mut() else {
-            continue;
-        };
-        let file = PathBuf::from(t.file());
-        if let (Some(dir), Some(name)) = (file.parent(), file.file_name()) {
-            if dir == out_abs || dir == out {
-                *t.file_mut() = name.to_string_lossy().into_owned();
+        for kind in [MapKind::Color, MapKind::Specular] {
+            let Some(t) = o.material.map_mut(kind) else {
+                continue;
+            };
+            let file = PathBuf::from(t.file());
+            if let (Some(dir), Some(name)) = (file.parent(), file.file_name()) {
+                if dir == out_abs || dir == out {
+                    *t.file_mut() = name.to_string_lossy().into_owned();
+                }
             }
         }
     }

@@ -8,9 +8,10 @@
 //! criterion's overdispersion read as a smooth misfit (a 3-photograph
 //! checker ball: SAD only halved, the map refused).
 //!
-//! The unknowns are the texels with evidence in some photograph (that an
-//! object is seen by two photographs at least is `texels.rs`'s rule); the
-//! others stay 1 (the scalar colour).
+//! The unknowns are the texels with evidence in at least `min_photos`
+//! photographs (that an object is seen by two photographs at least is
+//! `texels.rs`'s rule; a specular map asks it of each texel too); the
+//! others stay 1 (the scalar value).
 //! Each starts at the weighted median of its own samples' ratios and the
 //! normal equations are relaxed by Gauss-Seidel sweeps (`SWEEPS`, texels
 //! in order: deterministic). A value is then kept only when the SAD of
@@ -105,13 +106,14 @@ fn lists(n: usize, items: impl Iterator<Item = (usize, u32)> + Clone) -> (Vec<us
     (start, out)
 }
 
-/// Fits channel `c` of a map of `texels` texels to `samples`.
+/// Fits channel `c` of a map of `texels` texels to `samples`, a texel
+/// solved when its cell holds evidence from `min_photos` photographs.
 pub fn fit_channel(
     samples: &[Sample],
     c: usize,
     texels: usize,
     levels: &Levels,
-    cost: f64,
+    (cost, min_photos): (f64, usize),
 ) -> Fitted {
     let eq: Vec<(f64, f64, f64)> = samples.iter().map(|s| equation(s, c, levels)).collect();
     let cells = lists(
@@ -126,7 +128,7 @@ pub fn fit_channel(
             .flat_map(|(i, s)| (0..4).map(move |j| (4 * i + j, s.texels[j]))),
     );
     let mut m = vec![1.0; texels];
-    let active = start(&eq, &cells, &mut m);
+    let active = start(samples, &eq, &cells, &mut m, min_photos);
     let mut p: Vec<f64> = samples
         .iter()
         .map(|s| {
@@ -147,24 +149,32 @@ pub fn fit_channel(
     Fitted { m, kept }
 }
 
-/// Marks the texels with evidence and starts each at the weighted median of its cell's ratios b / a, weighed
+/// Marks the texels with evidence from `min_photos` photographs and
+/// starts each at the weighted median of its cell's ratios b / a, weighed
 /// by the levels between lit and dark.
 fn start(
+    samples: &[Sample],
     eq: &[(f64, f64, f64)],
     (start, list): &(Vec<usize>, Vec<u32>),
     m: &mut [f64],
+    min_photos: usize,
 ) -> Vec<bool> {
     let mut active = vec![false; m.len()];
     let mut ratios = Vec::new();
     for k in 0..m.len() {
         ratios.clear();
+        // A cell's samples come in photograph order: count the changes.
+        let (mut photos, mut last) = (0, None);
         for &s in &list[start[k]..start[k + 1]] {
             let (a, b, w) = eq[s as usize];
             if w > 0.0 {
                 ratios.push((b / a, w.sqrt() * a));
+                let photo = samples[s as usize].photo;
+                photos += usize::from(last != Some(photo));
+                last = Some(photo);
             }
         }
-        if !ratios.is_empty() {
+        if !ratios.is_empty() && photos >= min_photos {
             active[k] = true;
             m[k] = weighted_median(&mut ratios).clamp(0.0, MAX_MULTIPLIER);
         }
@@ -300,7 +310,7 @@ mod tests {
                 }
             }
         }
-        let f = fit_channel(&samples, 0, 16, &levels, 0.0);
+        let f = fit_channel(&samples, 0, 16, &levels, (0.0, 1));
         for k in 0..16u32 {
             if k % 4 == 3 {
                 assert!(!f.kept[k as usize] && f.m[k as usize] == 1.0, "texel {k}");
@@ -314,5 +324,43 @@ mod tests {
                 );
             }
         }
+    }
+
+    /// A 2 x 1 map, each texel's cell seen at its centre (the lookup
+    /// there is that texel alone): texel 0 by two photographs, texel 1 by
+    /// one. Asked for two photographs a texel, the fit solves texel 0 (to
+    /// the true 0.5) and leaves texel 1 at 1, uncounted; asked for one,
+    /// it solves both.
+    #[test]
+    fn a_texel_is_solved_only_with_evidence_from_enough_photographs() {
+        let layout = Layout {
+            side: 2,
+            scale: [1.0, 1.0],
+        };
+        let levels = Levels::new(None);
+        let mut samples = Vec::new();
+        for (photo, uv) in [(0u16, [0.25, 0.75]), (1, [0.25, 0.75]), (0, [0.75, 0.75])] {
+            let (texels, weights) = layout.bilinear(uv);
+            let (lit, dark) = (0.4, 0.05);
+            let t = levels.level(dark + 0.5 * (lit - dark));
+            samples.push(Sample {
+                photo,
+                texels,
+                weights,
+                nearest: layout.texel(uv) as u32,
+                levels: [[t, levels.level(lit), levels.level(dark)]; 3],
+            });
+        }
+        samples.sort_by_key(|s| s.photo);
+        let two = fit_channel(&samples, 0, 4, &levels, (0.0, 2));
+        let (t0, t1) = (layout.texel([0.25, 0.75]), layout.texel([0.75, 0.75]));
+        assert!(
+            two.kept[t0] && (two.m[t0] - 0.5).abs() < 0.02,
+            "{:?}",
+            two.m
+        );
+        assert!(!two.kept[t1] && two.m[t1] == 1.0, "{:?}", two.m);
+        let one = fit_channel(&samples, 0, 4, &levels, (0.0, 1));
+        assert!(one.kept[t0] && one.kept[t1], "{:?}", one.kept);
     }
 }

@@ -1,12 +1,18 @@
-//! The closed-form solve of `albedo_map`: a colour texture in each
-//! object's frame, a multiplier of its diffuse colour per texel and
-//! channel, from every photograph that sees the texel, whatever its
-//! camera and light (a fixed camera is the case where each texel's pixels
-//! lie at one place in every photograph). A render is linear in the map
+//! The closed-form solve of `albedo_map` and `specular_map`: a texture in
+//! each object's frame, a multiplier of its diffuse colour per texel and
+//! channel, or of its specular strength per texel (one value for the
+//! three channels: a highlight takes the light's colour), from every
+//! photograph that sees the texel, whatever its camera and light (a fixed
+//! camera is the case where each texel's pixels lie at one place in every
+//! photograph). A render is linear in the map
 //! (`lit` with it at 1, `dark` at 0: target = dark + m (lit - dark) in
 //! linear values, m the map's bilinear lookup where the pixel sees the
 //! object: the surface pass, `render::surface_coords`), so the map is a
-//! linear least-squares problem (`texel_fit.rs`).
+//! linear least-squares problem (`texel_fit.rs`). A specular map's
+//! evidence is the highlights: a texel is solved only where highlights of
+//! `MIN_PHOTOGRAPHS` photographs fall on it (one photograph's highlight
+//! is as well explained by a misplaced light), else it keeps the scalar
+//! strength.
 //!
 //! Everything is measured in the file's levels, where the criterion
 //! measures the fit: a sample is evidence when the map moves it (the lit
@@ -16,14 +22,16 @@
 //! and weighed by the levels a unit of the map moves it.
 //!
 //! Memory: one 64-byte sample per counted pixel of every photograph that
-//! sees a covered object, 16 bytes more for the texels' lists, besides
-//! the maps (`texel_layout.rs` caps their side).
+//! sees a covered object (three for a specular map: one per channel),
+//! 16 bytes more for the texels' lists, besides the maps
+//! (`texel_layout.rs` caps their side).
 
 use super::texel_fit::{fit_channel, Fitted, Levels, Sample};
 use super::texel_layout::Layout;
 use crate::metric::Mask;
 use crate::raster::Image;
 use crate::render::SurfaceCoords;
+use crate::scene::texture::MapKind;
 use crate::scene::Response;
 
 /// Photographs an object's map needs in view: in one photograph a map
@@ -59,10 +67,15 @@ pub struct ObjectMap {
     pub count: usize,
 }
 
-/// Per laid-out object, its samples in photograph and pixel order; and
-/// the criterion's N and SAD of the model without the maps over every
-/// counted pixel.
-fn samples(evidence: &[Evidence], layouts: &[Option<Layout>]) -> (Vec<Vec<Sample>>, f64, f64) {
+/// Per laid-out object, its samples in photograph and pixel order (a
+/// `pooled` map's, one per channel, each holding that channel's levels in
+/// every slot); and the criterion's N and SAD of the model without the
+/// maps over every counted pixel.
+fn samples(
+    evidence: &[Evidence],
+    layouts: &[Option<Layout>],
+    pooled: bool,
+) -> (Vec<Vec<Sample>>, f64, f64) {
     let mut out = vec![Vec::new(); layouts.len()];
     let (mut n, mut sad) = (0.0_f64, 0.0);
     for (k, e) in evidence.iter().enumerate() {
@@ -84,13 +97,18 @@ fn samples(evidence: &[Evidence], layouts: &[Option<Layout>]) -> (Vec<Vec<Sample
             let uv = sp.uv.map(f64::from);
             let (texels, weights) = layout.bilinear(uv);
             let c = |c: usize| [t[3 * p + c], l[3 * p + c], d[3 * p + c]];
-            out[o].push(Sample {
+            let sample = |levels| Sample {
                 photo: k as u16,
                 texels,
                 weights,
                 nearest: layout.texel(uv) as u32,
-                levels: [c(0), c(1), c(2)],
-            });
+                levels,
+            };
+            if pooled {
+                out[o].extend((0..3).map(|i| sample([c(i); 3])));
+            } else {
+                out[o].push(sample([c(0), c(1), c(2)]));
+            }
         }
     }
     (out, n, sad)
@@ -99,11 +117,13 @@ fn samples(evidence: &[Evidence], layouts: &[Option<Layout>]) -> (Vec<Vec<Sample
 /// The criterion's N (channel values counted over every photograph) and
 /// the SAD of the model without the maps over them.
 pub fn totals(evidence: &[Evidence]) -> (f64, f64) {
-    let (_, n, sad) = samples(evidence, &[]);
+    let (_, n, sad) = samples(evidence, &[], false);
     (n, sad)
 }
 
-/// Solves each laid-out object's map from every photograph's evidence.
+/// Solves each laid-out object's map of `kind` from every photograph's
+/// evidence: a colour map per channel, a specular map one value per texel
+/// for the three (written grey).
 /// A value is kept only when it earns its place in the criterion:
 /// `BIC = 2N ln(SAD/N) + k ln N` falls by adding it when the SAD of the
 /// samples in its texel falls by more than `ln N SAD / 2N` (SAD and N
@@ -113,9 +133,14 @@ pub fn solve(
     evidence: &[Evidence],
     layouts: &[Option<Layout>],
     response: Option<Response>,
+    kind: MapKind,
 ) -> Vec<ObjectMap> {
     let levels = Levels::new(response);
-    let (samples, n, sad) = samples(evidence, layouts);
+    let pooled = kind == MapKind::Specular;
+    let (samples, n, sad) = samples(evidence, layouts, pooled);
+    // A colour map's texel is pinned by its object's other texels (seen
+    // by two photographs or more); a highlight is pinned only by another.
+    let (channels, per_texel) = if pooled { (1, MIN_PHOTOGRAPHS) } else { (3, 1) };
     let cost = if n > 1.0 {
         sad * n.ln() / (2.0 * n)
     } else {
@@ -130,10 +155,11 @@ pub fn solve(
         let texels = (layout.side * layout.side) as usize;
         let mut values = vec![1.0_f32; 3 * texels];
         let mut count = 0;
-        for c in 0..3 {
-            let Fitted { m, kept } = fit_channel(samples, c, texels, &levels, cost);
+        for c in 0..channels {
+            let Fitted { m, kept } = fit_channel(samples, c, texels, &levels, (cost, per_texel));
             for k in (0..texels).filter(|&k| kept[k]) {
-                values[3 * k + c] = m[k] as f32;
+                let written = if pooled { 0..3 } else { c..c + 1 };
+                values[3 * k..3 * k + 3][written].fill(m[k] as f32);
                 count += 1;
             }
         }

@@ -110,7 +110,13 @@ impl Refits<'_> {
                     .collect();
                 self.run_spread(&trial.start, &trial.own, spread)?
             }
-            Refit::ClosedForm => return super::albedo::solved(self, model, round),
+            Refit::ClosedForm => {
+                let kind = trial
+                    .effect
+                    .map_kind()
+                    .expect("a closed-form effect solves a map");
+                return super::albedo::solved(self, model, round, kind);
+            }
         };
         Ok(Some((fitted, 0)))
     }

@@ -362,6 +362,16 @@ impl Material {
         }
     }
 
+    /// The material's slot for a map of `kind` (to set or clear it).
+    pub fn map_slot(&mut self, kind: MapKind) -> &mut Option<TextureRef> {
+        match kind {
+            MapKind::Color => &mut self.color_map,
+            MapKind::Specular => &mut self.specular_map,
+            MapKind::Shininess => &mut self.shininess_map,
+            MapKind::Normal => &mut self.normal_map,
+        }
+    }
+
     /// True when any map is present.
     pub fn has_maps(&self) -> bool {
         MapKind::ALL.iter().any(|&k| self.map(k).is_some())

@@ -40,6 +40,7 @@ pub fn json(path: &Path) -> serde_json::Value {
     .unwrap()
 }
 
+pub mod texture_set;
 pub mod traps;
 
 /// The signature and header chunk of a PNG of `w` x `h`, nothing else.

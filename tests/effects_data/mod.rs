@@ -14,8 +14,10 @@ use scenefit::scene::{Light, LightKind, Response, Scene, Vignetting};
 use std::path::Path;
 
 /// The effects the diagnosis of one photograph knows, in the order it
-/// tries them, but `albedo_map`: planting it needs a map file, and one
-/// photograph cannot tell it (tests/albedo_map.rs tries it on sets).
+/// tries them, but the maps solved in closed form (`albedo_map`,
+/// `specular_map`): planting one needs a map file, and one photograph
+/// cannot tell it (tests/albedo_map.rs and tests/texture_set.rs try them
+/// on sets).
 pub fn effects() -> Vec<&'static str> {
     set_effects()
         .into_iter()
@@ -24,11 +26,11 @@ pub fn effects() -> Vec<&'static str> {
 }
 
 /// The effects a generated set plants: [`effects`] and those only a set
-/// shows (each photograph's own light colour).
+/// shows (each photograph's own light colour); not the maps.
 pub fn set_effects() -> Vec<&'static str> {
     scenefit::diagnose::effects::names()
         .into_iter()
-        .filter(|&e| e != "albedo_map")
+        .filter(|&e| !scenefit::diagnose::effects::by_name(e).is_some_and(|x| x.closed_form()))
         .collect()
 }
 

@@ -5,6 +5,7 @@
 
 use super::Effect;
 use crate::diagnose::features::Features;
+use crate::scene::texture::MapKind;
 use crate::scene::{FreeParam, Scene};
 
 pub struct AlbedoMap;
@@ -23,30 +24,36 @@ impl Effect for AlbedoMap {
     /// Applies while some object has a diffuse colour for it to multiply
     /// and no map of its own (`covered`).
     fn extend(&self, scene: &Scene) -> Option<(Scene, Vec<FreeParam>)> {
-        if !covered(scene).contains(&true) {
+        if !covered(scene, MapKind::Color).contains(&true) {
             return None;
         }
         Some((scene.clone(), Vec::new()))
     }
 
-    fn closed_form(&self) -> bool {
-        true
+    fn map_kind(&self) -> Option<MapKind> {
+        Some(MapKind::Color)
     }
 }
 
-/// The objects the map covers: those with a diffuse colour for it to
-/// multiply and no map of their own (a colour texture, or a map in the
-/// image's frame).
-pub(crate) fn covered(scene: &Scene) -> Vec<bool> {
+/// The objects a map of `kind` covers. A colour map: those with a diffuse
+/// colour for it to multiply and no map of their own (a colour texture,
+/// or a map in the image's frame). A specular map: the glossy ones
+/// (specular strength above 0 for it to multiply) with no specular map.
+pub(crate) fn covered(scene: &Scene, kind: MapKind) -> Vec<bool> {
     scene
         .objects
         .iter()
         .map(|o| {
             let m = &o.material;
-            m.diffuse > 0.0
-                && m.color != [0.0; 3]
-                && m.color_map.is_none()
-                && m.albedo_map.is_none()
+            match kind {
+                MapKind::Specular => m.specular > 0.0 && m.specular_map.is_none(),
+                _ => {
+                    m.diffuse > 0.0
+                        && m.color != [0.0; 3]
+                        && m.color_map.is_none()
+                        && m.albedo_map.is_none()
+                }
+            }
         })
         .collect()
 }

@@ -4,6 +4,7 @@
 
 use super::edit::Trades;
 use crate::diagnose::features::Features;
+use crate::scene::texture::MapKind;
 use crate::scene::{FreeParam, Scene};
 
 /// One effect of the library.
@@ -44,11 +45,17 @@ pub trait Effect: Sync {
         Trades::default()
     }
 
-    /// True for an effect solved in closed form rather than searched (one
-    /// value per pixel: `albedo_map`, solved in `diagnose/albedo.rs`); its
-    /// `extend` adds no free entries.
+    /// The kind of texture a closed-form effect solves, one value per
+    /// texel (`albedo_map` a colour map, `specular_map` a specular one,
+    /// solved in `diagnose/albedo.rs`); None for a searched effect.
+    fn map_kind(&self) -> Option<MapKind> {
+        None
+    }
+
+    /// True for an effect solved in closed form rather than searched (a
+    /// map: [`Effect::map_kind`]); its `extend` adds no free entries.
     fn closed_form(&self) -> bool {
-        false
+        self.map_kind().is_some()
     }
 
     /// True for an effect only a set of photographs can tell apart from

@@ -22,6 +22,7 @@ mod light_falloff;
 mod near_light;
 mod second_light;
 mod specular_lobe;
+mod specular_map;
 mod vignetting;
 
 use crate::scene::{FreeParam, Scene};
@@ -43,6 +44,7 @@ pub static ALL: &[&dyn Effect] = &[
     &grazing_diffuse::GrazingDiffuse,
     &light_color::LightColor,
     &albedo_map::AlbedoMap,
+    &specular_map::SpecularMap,
 ];
 
 /// The names of [`ALL`], in order.

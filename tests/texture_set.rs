@@ -1,0 +1,142 @@
+//! The diagnosis on generated textured sets (`common/texture_set.rs`): a
+//! sphere and a plane, 10 photographs each with the camera and the light
+//! moving, the colour texture unknown and a second material region with a
+//! quarter of the specular strength. The colour map and then the specular
+//! map are accepted, the specular map written beside improved_scene.json
+//! and named by it; on the same surfaces with a uniform material neither
+//! map is. Each case prints its measures (colour error on texels seen by
+//! 3 photographs or more, deviation after ÷ before, held-out ÷ noise
+//! floor; docs/results.md records them).
+
+mod common;
+
+use common::texture_set::{self, Surface};
+use serde_json::Value;
+use std::path::{Path, PathBuf};
+
+/// Fits and diagnoses the set of `surface` in a fresh directory (or
+/// `TEXTURE_SET_KEEP/NAME`); the directory and diagnosis.json.
+fn diagnosed(
+    surface: Surface,
+    textured: bool,
+    name: &str,
+) -> (tempfile::TempDir, PathBuf, Value, Vec<f64>) {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = match std::env::var("TEXTURE_SET_KEEP") {
+        Ok(keep) => Path::new(&keep).join(name),
+        Err(_) => tmp.path().to_path_buf(),
+    };
+    std::fs::create_dir_all(&dir).unwrap();
+    let floors = texture_set::write(&dir, surface, textured);
+    let run = |args: &[&str]| {
+        let o = common::scenefit(&dir, args);
+        assert!(o.status.success(), "{args:?}: {}", common::stderr(&o));
+    };
+    run(&[
+        "fit",
+        "model.json",
+        "--shots",
+        "shots.json",
+        "-o",
+        "fit",
+        "--strategy",
+        "hybrid",
+        "--quiet",
+        "--overwrite",
+    ]);
+    run(&[
+        "diagnose",
+        "fit",
+        "-o",
+        "diag",
+        "--max-effects",
+        "3",
+        "--overwrite",
+    ]);
+    let d = common::json(&dir.join("diag/diagnosis.json"));
+    (tmp, dir, d, floors)
+}
+
+fn accepted(d: &Value) -> Vec<String> {
+    d["accepted"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter_map(|v| v.as_str().map(String::from))
+        .collect()
+}
+
+/// The measures of a diagnosed set, printed: colour error, deviation
+/// after ÷ before, held-out ÷ noise floor; returned in that order.
+fn measures(name: &str, surface: Surface, dir: &Path, d: &Value, floors: &[f64]) -> [f64; 3] {
+    let improved = scenefit::scene::load(&dir.join("diag/improved_scene.json")).unwrap();
+    let (err, texels) = texture_set::colour_error(&improved, surface);
+    let ratio = d["deviation_after"]["average"].as_f64().unwrap()
+        / d["deviation_before"]["average"].as_f64().unwrap();
+    let held = &d["held_out"][0];
+    let held_ratio =
+        held["deviation_after"]["average"].as_f64().unwrap() / floors[texture_set::SHOTS - 1];
+    println!(
+        "{name}: accepted {:?}; colour error {err:.4} over {texels} texels seen by >= 3 photographs; \
+         deviation {:.3} % -> {:.3} % (x{ratio:.2}); held-out {} {:.3} % -> {:.3} %, floor {:.3} % (x{held_ratio:.2})",
+        accepted(d),
+        d["deviation_before"]["average"],
+        d["deviation_after"]["average"],
+        held["name"],
+        held["deviation_fit"]["average"],
+        held["deviation_after"]["average"],
+        floors[texture_set::SHOTS - 1],
+    );
+    [err, ratio, held_ratio]
+}
+
+/// The colour map, then the specular map, each in the list of accepted
+/// effects, the specular map after the colour map; the specular map
+/// written beside improved_scene.json (a grey linear PNG, named by a
+/// relative path).
+fn maps_accepted_in_order(d: &Value, dir: &Path) {
+    let a = accepted(d);
+    let at = |e: &str| a.iter().position(|x| x == e);
+    let (color, spec) = (at("albedo_map"), at("specular_map"));
+    assert!(color.is_some() && spec.is_some(), "accepted {a:?}");
+    assert!(color < spec, "accepted {a:?}");
+    let improved = common::json(&dir.join("diag/improved_scene.json"));
+    let map = &improved["objects"][0]["material"]["specular_map"];
+    let file = map["file"].as_str().unwrap();
+    assert!(!Path::new(file).is_absolute(), "{map}");
+    assert!(dir.join("diag").join(file).exists(), "{map}");
+    assert_eq!(map["encoding"], "linear");
+}
+
+#[test]
+#[ignore = "not yet seen to pass: about an hour a set on the shared machine of 2026-11-27 (docs/results.md, specular map)"]
+fn a_textured_sphere_accepts_the_colour_map_then_the_specular_map() {
+    let (_tmp, dir, d, floors) = diagnosed(Surface::Sphere, true, "sphere");
+    measures("sphere", Surface::Sphere, &dir, &d, &floors);
+    maps_accepted_in_order(&d, &dir);
+}
+
+#[test]
+#[ignore = "not yet seen to pass: about an hour a set on the shared machine of 2026-11-27 (docs/results.md, specular map)"]
+fn a_textured_plane_accepts_the_colour_map_then_the_specular_map() {
+    let (_tmp, dir, d, floors) = diagnosed(Surface::Plane, true, "plane");
+    measures("plane", Surface::Plane, &dir, &d, &floors);
+    maps_accepted_in_order(&d, &dir);
+}
+
+#[test]
+#[ignore = "not yet seen to pass: about an hour a set on the shared machine of 2026-11-27 (docs/results.md, specular map)"]
+fn a_uniform_material_accepts_neither_map() {
+    for (surface, name) in [
+        (Surface::Sphere, "uniform_sphere"),
+        (Surface::Plane, "uniform_plane"),
+    ] {
+        let (_tmp, dir, d, floors) = diagnosed(surface, false, name);
+        measures(name, surface, &dir, &d, &floors);
+        let a = accepted(&d);
+        assert!(
+            !a.iter().any(|e| e == "albedo_map" || e == "specular_map"),
+            "{name}: accepted {a:?}"
+        );
+    }
+}
