@@ -103,8 +103,14 @@ fn the_texture_free_footing_takes_the_response_of_a_linear_trap() {
     );
     let candidates = d["candidates"].as_array().expect("candidates is a list");
     // Every searched candidate of round 1 (no colour map yet) is weighed
-    // on both footings; the closed-form map is weighed plainly.
-    let searched = |c: &&serde_json::Value| c["round"] == 1 && c["effect"] != "albedo_map";
+    // on both footings; the closed-form maps are weighed plainly.
+    let closed_form = |c: &serde_json::Value| {
+        c["effect"]
+            .as_str()
+            .and_then(scenefit::diagnose::effects::by_name)
+            .is_some_and(|e| e.closed_form())
+    };
+    let searched = |c: &&serde_json::Value| c["round"] == 1 && !closed_form(c);
     for c in candidates.iter().filter(searched) {
         let f = &c["footing"];
         assert!(f.is_object(), "no footing: {c}");
