@@ -6,6 +6,7 @@
 //! the deviation falls to at most 30 %; a set with noise only and a single
 //! photograph of the stained ball do not accept it.
 
+mod common;
 mod effects_data;
 
 use scenefit::render::{from_spec, render_one};
@@ -55,15 +56,6 @@ fn run(dir: &Path, args: &[&str]) -> std::process::Output {
         .unwrap()
 }
 
-fn run_ok(dir: &Path, args: &[&str]) {
-    let o = run(dir, args);
-    assert!(
-        o.status.success(),
-        "{args:?}: {}",
-        String::from_utf8_lossy(&o.stderr)
-    );
-}
-
 /// Writes `shots` photographs of the truth (the map planted when `map`),
 /// the light moved around the ball, and the model and shots files; the
 /// true light positions.
@@ -106,20 +98,14 @@ fn make_set(dir: &Path, shots: usize, map: bool, noise: f64) -> (Scene, Vec<[f64
 }
 
 fn fit_and_diagnose(dir: &Path, shots: bool) -> Value {
-    let mut fit = vec!["fit", "model.json", "-o", "fit", "--population", "30"];
+    let mut fit = vec!["model.json", "--population", "30"];
     if shots {
         fit.extend(["--shots", "shots.json", "--strategy", "hybrid"]);
         fit.extend(["--generations", "150", "--quiet"]);
     } else {
         fit.extend(["--target", "s0.png", "--generations", "150", "--quiet"]);
     }
-    run_ok(dir, &fit);
-    run_ok(
-        dir,
-        &["diagnose", "fit", "-o", "diag", "--max-effects", "1"],
-    );
-    let text = std::fs::read_to_string(dir.join("diag/diagnosis.json")).unwrap();
-    serde_json::from_str(&text).unwrap()
+    common::fit_and_diagnose(dir, &fit, &["--max-effects", "1"])
 }
 
 fn accepted(d: &Value) -> Vec<String> {

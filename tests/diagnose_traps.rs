@@ -49,24 +49,15 @@ fn write_trap_sets() {
 /// Fits `dir`'s set as a user would (`fit --shots`, nothing declared) and
 /// diagnoses it; diagnosis.json.
 fn fit_and_diagnose(dir: &Path) -> serde_json::Value {
-    for args in [
-        &[
-            "fit",
-            "scene.json",
-            "--shots",
-            "shots.json",
-            "-o",
-            "fit",
-            "--strategy",
-            "hybrid",
-            "--quiet",
-        ][..],
-        &["diagnose", "fit", "-o", "diag"][..],
-    ] {
-        let o = common::scenefit(dir, args);
-        assert!(o.status.success(), "{args:?}: {}", common::stderr(&o));
-    }
-    common::json(&dir.join("diag/diagnosis.json"))
+    let fit = [
+        "scene.json",
+        "--shots",
+        "shots.json",
+        "--strategy",
+        "hybrid",
+        "--quiet",
+    ];
+    common::fit_and_diagnose(dir, &fit, &[])
 }
 
 fn accepted(d: &serde_json::Value) -> Vec<String> {

@@ -8,13 +8,13 @@
 //! it was for every effect (measured: 12 of 12, the worst fresnel at 0.13,
 //! docs/results.md); a set with noise only accepts nothing.
 
+mod common;
 mod effects_data;
 
 use effects_data::{case, set_effects};
 use scenefit::render::{from_spec, render_one};
 use serde_json::json;
 use std::path::Path;
-use std::process::Command;
 
 const SHOTS: usize = 8;
 
@@ -73,26 +73,11 @@ fn diagnose_set(effect: &str, seed: u64, noise: f64, dir: &Path) -> serde_json::
         json!({"format": "scenefit-shots/1", "shots": shots}).to_string(),
     )
     .unwrap();
-    let run = |args: &[&str]| {
-        let o = Command::new(env!("CARGO_BIN_EXE_scenefit"))
-            .current_dir(dir)
-            .args(args)
-            .output()
-            .unwrap();
-        assert!(
-            o.status.success(),
-            "{args:?}: {}",
-            String::from_utf8_lossy(&o.stderr)
-        );
-    };
     let seed = seed.to_string();
-    run(&[
-        "fit",
+    let fit = [
         "model.json",
         "--shots",
         "shots.json",
-        "-o",
-        "fit",
         "--strategy",
         "hybrid",
         "--population",
@@ -102,19 +87,8 @@ fn diagnose_set(effect: &str, seed: u64, noise: f64, dir: &Path) -> serde_json::
         "--seed",
         &seed,
         "--quiet",
-    ]);
-    run(&[
-        "diagnose",
-        "fit",
-        "-o",
-        "diag",
-        "--max-effects",
-        "1",
-        "--seed",
-        &seed,
-    ]);
-    serde_json::from_str(&std::fs::read_to_string(dir.join("diag/diagnosis.json")).unwrap())
-        .unwrap()
+    ];
+    common::fit_and_diagnose(dir, &fit, &["--max-effects", "1", "--seed", &seed])
 }
 
 fn first(d: &serde_json::Value) -> String {

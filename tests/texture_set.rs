@@ -28,32 +28,16 @@ fn diagnosed(
     };
     std::fs::create_dir_all(&dir).unwrap();
     let floors = texture_set::write(&dir, surface, textured);
-    let run = |args: &[&str]| {
-        let o = common::scenefit(&dir, args);
-        assert!(o.status.success(), "{args:?}: {}", common::stderr(&o));
-    };
-    run(&[
-        "fit",
+    let fit = [
         "model.json",
         "--shots",
         "shots.json",
-        "-o",
-        "fit",
         "--strategy",
         "hybrid",
         "--quiet",
         "--overwrite",
-    ]);
-    run(&[
-        "diagnose",
-        "fit",
-        "-o",
-        "diag",
-        "--max-effects",
-        "3",
-        "--overwrite",
-    ]);
-    let d = common::json(&dir.join("diag/diagnosis.json"));
+    ];
+    let d = common::fit_and_diagnose(&dir, &fit, &["--max-effects", "3", "--overwrite"]);
     (tmp, dir, d, floors)
 }
 

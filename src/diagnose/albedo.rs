@@ -231,7 +231,7 @@ fn written_maps(
     }
     let mut refs = Vec::new();
     for map in &solved {
-        let path = super::map_file::path(fits.out, kind, tag, map.object, map.layout.side);
+        let path = super::map_file::path(fits.out, kind, tag, map.object, map.layout.side)?;
         refs.push((map.object, super::map_file::write(&path, map)?));
     }
     let count = solved.iter().map(|m| m.count).sum();

@@ -7,6 +7,7 @@
 //! tracer does; the probe that sets every covered colour to 0; and the
 //! scene as improved_scene.json names them, by paths relative to it.
 
+use super::effects;
 use super::texels::ObjectMap;
 use crate::error::{Error, Result};
 use crate::scene::texture::{Encoding, MapKind, TextureRef, TextureSpec};
@@ -48,37 +49,45 @@ pub fn write(path: &Path, map: &ObjectMap) -> Result<TextureRef> {
     Ok(reference(path, map.layout.scale, hi))
 }
 
+/// The kinds of map the diagnosis solves and writes, each with the name
+/// of the effect that solves it ([`effects::Effect::map_kind`]): the one table
+/// the file names are read from, so a new map effect needs no edit here.
+fn solved_kinds() -> impl Iterator<Item = (MapKind, &'static str)> {
+    effects::ALL
+        .iter()
+        .filter_map(|e| e.map_kind().map(|k| (k, e.name())))
+}
+
 /// The prefix of every file of a map of `kind` the diagnosis writes: the
-/// effect's name.
-fn prefix(kind: MapKind) -> &'static str {
-    match kind {
-        MapKind::Specular => "specular_map_",
-        _ => "albedo_map_",
-    }
+/// name of the effect that solves it; an error for a kind no effect
+/// solves (no file of it is ever written).
+fn prefix(kind: MapKind) -> Result<String> {
+    solved_kinds()
+        .find(|&(k, _)| k == kind)
+        .map(|(_, name)| format!("{name}_"))
+        .ok_or_else(|| Error::Run(format!("no effect solves a {}", kind.key())))
 }
 
 /// True when `name` is a map file the diagnosis writes (of any kind).
 pub fn is_map_file(name: &str) -> bool {
-    let ours = [MapKind::Color, MapKind::Specular]
-        .iter()
-        .any(|&k| name.starts_with(prefix(k)));
+    let ours = solved_kinds().any(|(_, effect)| name.starts_with(&format!("{effect}_")));
     ours && (name.ends_with(".exr") || name.ends_with(".png"))
 }
 
 /// The file of object `object`'s map of `kind` at side `side` for the
 /// solve `tag` names, in `out` (each solve and side its own file: texels
 /// are read once per process and path).
-pub fn path(out: &Path, kind: MapKind, tag: &str, object: usize, side: u32) -> PathBuf {
+pub fn path(out: &Path, kind: MapKind, tag: &str, object: usize, side: u32) -> Result<PathBuf> {
     let p = out.join(format!(
         "{}{tag}_object{object}_side{side}.png",
-        prefix(kind)
+        prefix(kind)?
     ));
-    std::path::absolute(&p).unwrap_or(p)
+    Ok(std::path::absolute(&p).unwrap_or(p))
 }
 
 /// Writes the zero map of `kind` (one texel) into `out`; its reference.
 pub fn zero(out: &Path, kind: MapKind) -> Result<(PathBuf, TextureRef)> {
-    let path = out.join(format!("{}zero.png", prefix(kind)));
+    let path = out.join(format!("{}zero.png", prefix(kind)?));
     let path = std::path::absolute(&path).unwrap_or(path);
     write_png(&path, 1, vec![0; 3])?;
     let r = reference(&path, [1.0, 1.0], 1.0);
@@ -92,7 +101,7 @@ pub fn beside(scene: &Scene, out: &Path) -> Scene {
     let mut s = scene.clone();
     let out_abs = std::path::absolute(out).unwrap_or(out.to_path_buf());
     for o in &mut s.objects {
-        for kind in [MapKind::Color, MapKind::Specular] {
+        for (kind, _) in solved_kinds() {
             let Some(t) = o.material.map_mut(kind) else {
                 continue;
             };
@@ -105,4 +114,59 @@ pub fn beside(scene: &Scene, out: &Path) -> Scene {
         }
     }
     s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The names outside scripts read: for every kind, the map files of
+    /// the effect that solves it, or none when no effect does.
+    #[test]
+    fn every_map_kind_names_its_files_as_before() {
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path();
+        for kind in MapKind::ALL {
+            let expected = match kind {
+                MapKind::Color => Some("albedo_map_"),
+                MapKind::Specular => Some("specular_map_"),
+                MapKind::Shininess | MapKind::Normal => None,
+            };
+            let file = path(out, kind, "round2", 1, 64);
+            let zero = zero(out, kind);
+            let Some(p) = expected else {
+                assert!(file.is_err() && zero.is_err(), "{kind:?} has files");
+                continue;
+            };
+            let name = |p: &Path| p.file_name().unwrap().to_string_lossy().into_owned();
+            let file = name(&file.unwrap());
+            assert_eq!(file, format!("{p}round2_object1_side64.png"));
+            let (zero_path, _) = zero.unwrap();
+            assert_eq!(name(&zero_path), format!("{p}zero.png"));
+            assert!(zero_path.exists());
+            assert!(is_map_file(&file) && is_map_file(&name(&zero_path)));
+        }
+        assert!(!is_map_file("albedo_map.png") && !is_map_file("albedo_map_x.json"));
+        assert!(!is_map_file("shininess_map_zero.png"));
+    }
+
+    /// A map in the diagnosis directory is named by its file name alone,
+    /// for every kind an effect solves.
+    #[test]
+    fn beside_names_every_solved_kind_by_its_file_name() {
+        let dir = tempfile::tempdir().unwrap();
+        let out = std::path::absolute(dir.path()).unwrap();
+        let mut scene = crate::scene::test_scene::ball(r#""color": [0.5, 0.5, 0.5]"#, "");
+        for kind in [MapKind::Color, MapKind::Specular] {
+            let (_, r) = zero(&out, kind).unwrap();
+            *scene.objects[0].material.map_slot(kind) = Some(r);
+        }
+        let s = beside(&scene, &out);
+        let m = &s.objects[0].material;
+        assert_eq!(m.map(MapKind::Color).unwrap().file(), "albedo_map_zero.png");
+        assert_eq!(
+            m.map(MapKind::Specular).unwrap().file(),
+            "specular_map_zero.png"
+        );
+    }
 }

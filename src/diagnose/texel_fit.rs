@@ -1,6 +1,7 @@
-//! One channel of one object's colour texture (`texels.rs`) fitted to its
-//! samples: the multipliers m whose bilinear lookup best explains each
-//! sample, target = dark + (Σ w m)(lit - dark) in linear values, by least
+//! One channel of one object's colour texture (`texels.rs`), or the one
+//! value per texel of a scalar map (a specular strength: each sample's
+//! three channels are three equations in it), fitted to its samples: the
+//! multipliers m whose bilinear lookup best explains each sample, target = dark + (Σ w m)(lit - dark) in linear values, by least
 //! squares in the file's levels (each sample weighed by the levels a unit
 //! of the map moves it). Solving per texel alone (each pixel given to the
 //! texel whose cell holds it) left the bilinear lookup to blur every edge
@@ -19,6 +20,7 @@
 
 use crate::render::camera_effects;
 use crate::scene::Response;
+use std::ops::Range;
 
 /// The camera between the linear values the renderer shades and the
 /// 8-bit levels of the file, as the image-space pass writes them
@@ -106,16 +108,32 @@ fn lists(n: usize, items: impl Iterator<Item = (usize, u32)> + Clone) -> (Vec<us
     (start, out)
 }
 
-/// Fits channel `c` of a map of `texels` texels to `samples`, a texel
-/// solved when its cell holds evidence from `min_photos` photographs.
-pub fn fit_channel(
+/// Each sample's equations, one per channel of `channels` (the rest of
+/// the three weigh 0, no evidence).
+type Equations = Vec<[(f64, f64, f64); 3]>;
+
+/// Fits one value per texel of a map of `texels` texels to the
+/// `channels` of `samples` together (a colour map's channel alone, a
+/// scalar map's all three: each pixel taken once, its channels summed in
+/// the fit and in the SAD that decides what is kept), a texel solved when
+/// its cell holds evidence from `min_photos` photographs.
+pub fn fit_channels(
     samples: &[Sample],
-    c: usize,
+    channels: Range<usize>,
     texels: usize,
     levels: &Levels,
     (cost, min_photos): (f64, usize),
 ) -> Fitted {
-    let eq: Vec<(f64, f64, f64)> = samples.iter().map(|s| equation(s, c, levels)).collect();
+    let eq: Equations = samples
+        .iter()
+        .map(|s| {
+            let mut e = [(0.0, 0.0, 0.0); 3];
+            for (i, c) in channels.clone().enumerate() {
+                e[i] = equation(s, c, levels);
+            }
+            e
+        })
+        .collect();
     let cells = lists(
         texels,
         samples.iter().enumerate().map(|(i, s)| (i, s.nearest)),
@@ -140,7 +158,7 @@ pub fn fit_channel(
     for _ in 0..SWEEPS {
         sweep(samples, &eq, &touch, &active, &mut m, &mut p);
     }
-    let kept = keep(samples, c, levels, &cells, &active, &p, cost);
+    let kept = keep(samples, channels, levels, &cells, &active, &p, cost);
     for k in 0..texels {
         if !kept[k] {
             m[k] = 1.0;
@@ -154,7 +172,7 @@ pub fn fit_channel(
 /// by the levels between lit and dark.
 fn start(
     samples: &[Sample],
-    eq: &[(f64, f64, f64)],
+    eq: &Equations,
     (start, list): &(Vec<usize>, Vec<u32>),
     m: &mut [f64],
     min_photos: usize,
@@ -166,12 +184,13 @@ fn start(
         // A cell's samples come in photograph order: count the changes.
         let (mut photos, mut last) = (0, None);
         for &s in &list[start[k]..start[k + 1]] {
-            let (a, b, w) = eq[s as usize];
-            if w > 0.0 {
-                ratios.push((b / a, w.sqrt() * a));
-                let photo = samples[s as usize].photo;
-                photos += usize::from(last != Some(photo));
-                last = Some(photo);
+            for &(a, b, w) in &eq[s as usize] {
+                if w > 0.0 {
+                    ratios.push((b / a, w.sqrt() * a));
+                    let photo = samples[s as usize].photo;
+                    photos += usize::from(last != Some(photo));
+                    last = Some(photo);
+                }
             }
         }
         if !ratios.is_empty() && photos >= min_photos {
@@ -186,7 +205,7 @@ fn start(
 /// active texels; `p` holds each sample's lookup Σ w m and follows.
 fn sweep(
     samples: &[Sample],
-    eq: &[(f64, f64, f64)],
+    eq: &Equations,
     (start, list): &(Vec<usize>, Vec<u32>),
     active: &[bool],
     m: &mut [f64],
@@ -197,10 +216,11 @@ fn sweep(
         let (mut num, mut den) = (0.0, 0.0);
         for &e in entries {
             let (s, j) = (e as usize / 4, e as usize % 4);
-            let (a, b, w) = eq[s];
             let wk = samples[s].weights[j] as f64;
-            num += w * a * wk * (b - a * p[s]);
-            den += w * a * a * wk * wk;
+            for &(a, b, w) in &eq[s] {
+                num += w * a * wk * (b - a * p[s]);
+                den += w * a * a * wk * wk;
+            }
         }
         if den <= 1e-12 {
             continue;
@@ -216,10 +236,11 @@ fn sweep(
 }
 
 /// The active texels whose cell's samples, predicted through the fitted
-/// lookups `p`, drop their SAD in levels by more than `cost`.
+/// lookups `p`, drop their SAD in levels over `channels` by more than
+/// `cost`.
 fn keep(
     samples: &[Sample],
-    c: usize,
+    channels: Range<usize>,
     levels: &Levels,
     (start, list): &(Vec<usize>, Vec<u32>),
     active: &[bool],
@@ -232,10 +253,11 @@ fn keep(
             active[k] && {
                 let drop: f64 = list[start[k]..start[k + 1]]
                     .iter()
-                    .map(|&s| {
-                        let [t, l, d] = samples[s as usize].levels[c];
+                    .flat_map(|&s| channels.clone().map(move |c| (s as usize, c)))
+                    .map(|(s, c)| {
+                        let [t, l, d] = samples[s].levels[c];
                         let (ll, dl) = (lin[l as usize], lin[d as usize]);
-                        let predicted = levels.level(dl + p[s as usize] * (ll - dl));
+                        let predicted = levels.level(dl + p[s] * (ll - dl));
                         t.abs_diff(l) as f64 - t.abs_diff(predicted) as f64
                     })
                     .sum();
@@ -310,7 +332,7 @@ mod tests {
                 }
             }
         }
-        let f = fit_channel(&samples, 0, 16, &levels, (0.0, 1));
+        let f = fit_channels(&samples, 0..1, 16, &levels, (0.0, 1));
         for k in 0..16u32 {
             if k % 4 == 3 {
                 assert!(!f.kept[k as usize] && f.m[k as usize] == 1.0, "texel {k}");
@@ -352,7 +374,7 @@ mod tests {
             });
         }
         samples.sort_by_key(|s| s.photo);
-        let two = fit_channel(&samples, 0, 4, &levels, (0.0, 2));
+        let two = fit_channels(&samples, 0..1, 4, &levels, (0.0, 2));
         let (t0, t1) = (layout.texel([0.25, 0.75]), layout.texel([0.75, 0.75]));
         assert!(
             two.kept[t0] && (two.m[t0] - 0.5).abs() < 0.02,
@@ -360,7 +382,119 @@ mod tests {
             two.m
         );
         assert!(!two.kept[t1] && two.m[t1] == 1.0, "{:?}", two.m);
-        let one = fit_channel(&samples, 0, 4, &levels, (0.0, 1));
+        let one = fit_channels(&samples, 0..1, 4, &levels, (0.0, 1));
         assert!(one.kept[t0] && one.kept[t1], "{:?}", one.kept);
+    }
+
+    /// One texel (side 1) seen by two photographs whose three channels
+    /// each show half the map's reach: fitted to the three together it is
+    /// 0.5, kept at a cost that no channel's drop alone pays (the SAD
+    /// counted over the three channels of each pixel, one value).
+    #[test]
+    fn a_scalar_value_is_fitted_and_kept_on_the_three_channels_together() {
+        let layout = Layout {
+            side: 1,
+            scale: [1.0, 1.0],
+        };
+        let levels = Levels::new(None);
+        let mut samples = Vec::new();
+        for photo in [0u16, 1] {
+            let (texels, weights) = layout.bilinear([0.5, 0.5]);
+            let dark = 0.02;
+            let channel = |lit: f64| {
+                let t = levels.level(dark + 0.5 * (lit - dark));
+                [t, levels.level(lit), levels.level(dark)]
+            };
+            samples.push(Sample {
+                photo,
+                texels,
+                weights,
+                nearest: 0,
+                levels: [channel(0.3), channel(0.5), channel(0.7)],
+            });
+        }
+        let drop = |c: usize| -> f64 {
+            let m = samples.iter().map(|s| {
+                let [t, l, _] = s.levels[c];
+                t.abs_diff(l) as f64
+            });
+            m.sum::<f64>()
+        };
+        let (single, all) = (
+            (0..3).map(drop).fold(0.0, f64::max),
+            (0..3).map(drop).sum::<f64>(),
+        );
+        let cost = (single + all) / 2.0;
+        let f = fit_channels(&samples, 0..3, 1, &levels, (cost, 2));
+        assert!(f.kept[0] && (f.m[0] - 0.5).abs() < 0.02, "{:?}", f.m);
+        for c in 0..3 {
+            let one = fit_channels(&samples, c..c + 1, 1, &levels, (cost, 2));
+            assert!(!one.kept[0], "channel {c} alone kept");
+        }
+    }
+
+    /// Random samples of a map seen by four photographs, each channel
+    /// lit to its own level: the scalar fit on each pixel once gives the
+    /// values and kept texels of the fit on each pixel taken three times,
+    /// one channel each (the specular map's samples before), up to the
+    /// order of the sums.
+    #[test]
+    fn a_scalar_fit_equals_the_fit_of_its_pixels_tripled() {
+        use rand::{Rng, SeedableRng};
+        let levels = Levels::new(None);
+        for side in [1u32, 2, 8] {
+            let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(side as u64);
+            let layout = Layout {
+                side,
+                scale: [1.0, 1.0],
+            };
+            let n = (side * side) as usize;
+            let truth: Vec<f64> = (0..n).map(|_| rng.gen_range(0.2..2.0)).collect();
+            let mut single = Vec::new();
+            for photo in 0..4u16 {
+                for _ in 0..20 * n {
+                    let uv = [rng.gen::<f64>(), rng.gen::<f64>()];
+                    let (texels, weights) = layout.bilinear(uv);
+                    let m: f64 = (0..4)
+                        .map(|j| weights[j] as f64 * truth[texels[j] as usize])
+                        .sum();
+                    let dark = rng.gen_range(0.0..0.05);
+                    let mut channel = || {
+                        let lit = rng.gen_range(0.05..0.5);
+                        let noise = rng.gen_range(-0.01..0.01);
+                        let t = levels.level(dark + m * (lit - dark) + noise);
+                        [t, levels.level(lit), levels.level(dark)]
+                    };
+                    let levels = [channel(), channel(), channel()];
+                    let nearest = layout.texel(uv) as u32;
+                    single.push(Sample {
+                        photo,
+                        texels,
+                        weights,
+                        nearest,
+                        levels,
+                    });
+                }
+            }
+            let tripled: Vec<Sample> = single
+                .iter()
+                .flat_map(|s| {
+                    (0..3).map(move |c| Sample {
+                        levels: [s.levels[c]; 3],
+                        ..*s
+                    })
+                })
+                .collect();
+            for cost in [0.0, 20.0] {
+                let one = fit_channels(&single, 0..3, n, &levels, (cost, 2));
+                let three = fit_channels(&tripled, 0..1, n, &levels, (cost, 2));
+                assert_eq!(one.kept, three.kept, "side {side}, cost {cost}");
+                // A comparison of fits that solved something.
+                assert!(one.kept.contains(&true), "side {side}: nothing kept");
+                for (a, b) in one.m.iter().zip(&three.m) {
+                    assert!((a - b).abs() < 1e-9, "side {side}: {a} against {b}");
+                }
+            }
+        }
     }
 }

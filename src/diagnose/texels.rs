@@ -22,17 +22,18 @@
 //! and weighed by the levels a unit of the map moves it.
 //!
 //! Memory: one 64-byte sample per counted pixel of every photograph that
-//! sees a covered object (three for a specular map: one per channel),
-//! 16 bytes more for the texels' lists, besides the maps
+//! sees a covered object (a specular map's too: its three channels are
+//! fitted together, `texel_fit::fit_channels`), 16 bytes more for the texels' lists, besides the maps
 //! (`texel_layout.rs` caps their side).
 
-use super::texel_fit::{fit_channel, Fitted, Levels, Sample};
+use super::texel_fit::{fit_channels, Fitted, Levels, Sample};
 use super::texel_layout::Layout;
 use crate::metric::Mask;
 use crate::raster::Image;
 use crate::render::SurfaceCoords;
 use crate::scene::texture::MapKind;
 use crate::scene::Response;
+use std::ops::Range;
 
 /// Photographs an object's map needs in view: in one photograph a map
 /// matches its pixels whatever made them darker (a stain or a shadow the
@@ -42,6 +43,12 @@ use crate::scene::Response;
 /// each photograph's shading, and a texel only one sees is solved
 /// against it.
 const MIN_PHOTOGRAPHS: usize = 2;
+
+/// The fits of a colour map: each channel its own values.
+const PER_CHANNEL: &[Range<usize>] = &[0..1, 1..2, 2..3];
+/// The fit of a scalar map: one value per texel for the three channels.
+const ALL_CHANNELS: Range<usize> = 0..3;
+const SCALAR: &[Range<usize>] = &[ALL_CHANNELS];
 
 /// The photographs among `samples` (in photograph order).
 fn photographs(samples: &[Sample]) -> usize {
@@ -67,15 +74,10 @@ pub struct ObjectMap {
     pub count: usize,
 }
 
-/// Per laid-out object, its samples in photograph and pixel order (a
-/// `pooled` map's, one per channel, each holding that channel's levels in
-/// every slot); and the criterion's N and SAD of the model without the
+/// Per laid-out object, its samples in photograph and pixel order, one
+/// per pixel; and the criterion's N and SAD of the model without the
 /// maps over every counted pixel.
-fn samples(
-    evidence: &[Evidence],
-    layouts: &[Option<Layout>],
-    pooled: bool,
-) -> (Vec<Vec<Sample>>, f64, f64) {
+fn samples(evidence: &[Evidence], layouts: &[Option<Layout>]) -> (Vec<Vec<Sample>>, f64, f64) {
     let mut out = vec![Vec::new(); layouts.len()];
     let (mut n, mut sad) = (0.0_f64, 0.0);
     for (k, e) in evidence.iter().enumerate() {
@@ -97,18 +99,13 @@ fn samples(
             let uv = sp.uv.map(f64::from);
             let (texels, weights) = layout.bilinear(uv);
             let c = |c: usize| [t[3 * p + c], l[3 * p + c], d[3 * p + c]];
-            let sample = |levels| Sample {
+            out[o].push(Sample {
                 photo: k as u16,
                 texels,
                 weights,
                 nearest: layout.texel(uv) as u32,
-                levels,
-            };
-            if pooled {
-                out[o].extend((0..3).map(|i| sample([c(i); 3])));
-            } else {
-                out[o].push(sample([c(0), c(1), c(2)]));
-            }
+                levels: [c(0), c(1), c(2)],
+            });
         }
     }
     (out, n, sad)
@@ -117,7 +114,7 @@ fn samples(
 /// The criterion's N (channel values counted over every photograph) and
 /// the SAD of the model without the maps over them.
 pub fn totals(evidence: &[Evidence]) -> (f64, f64) {
-    let (_, n, sad) = samples(evidence, &[], false);
+    let (_, n, sad) = samples(evidence, &[]);
     (n, sad)
 }
 
@@ -136,11 +133,16 @@ pub fn solve(
     kind: MapKind,
 ) -> Vec<ObjectMap> {
     let levels = Levels::new(response);
-    let pooled = kind == MapKind::Specular;
-    let (samples, n, sad) = samples(evidence, layouts, pooled);
+    let scalar = kind == MapKind::Specular;
+    let (samples, n, sad) = samples(evidence, layouts);
     // A colour map's texel is pinned by its object's other texels (seen
     // by two photographs or more); a highlight is pinned only by another.
-    let (channels, per_texel) = if pooled { (1, MIN_PHOTOGRAPHS) } else { (3, 1) };
+    // A scalar map's one value is fitted to the three channels together.
+    let (fits, per_texel) = if scalar {
+        (SCALAR, MIN_PHOTOGRAPHS)
+    } else {
+        (PER_CHANNEL, 1)
+    };
     let cost = if n > 1.0 {
         sad * n.ln() / (2.0 * n)
     } else {
@@ -155,11 +157,12 @@ pub fn solve(
         let texels = (layout.side * layout.side) as usize;
         let mut values = vec![1.0_f32; 3 * texels];
         let mut count = 0;
-        for c in 0..channels {
-            let Fitted { m, kept } = fit_channel(samples, c, texels, &levels, (cost, per_texel));
+        for channels in fits {
+            let rule = (cost, per_texel);
+            let Fitted { m, kept } = fit_channels(samples, channels.clone(), texels, &levels, rule);
+            // One value counted per texel and fit: a scalar map's is one.
             for k in (0..texels).filter(|&k| kept[k]) {
-                let written = if pooled { 0..3 } else { c..c + 1 };
-                values[3 * k..3 * k + 3][written].fill(m[k] as f32);
+                values[3 * k..3 * k + 3][channels.clone()].fill(m[k] as f32);
                 count += 1;
             }
         }

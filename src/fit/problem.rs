@@ -6,11 +6,21 @@
 
 use super::executor::Problem;
 use super::FitTarget;
-use crate::metric::{blurred_levels, blurred_residuals, deviation, residuals, Deviation};
+use crate::metric::{
+    blurred_levels, blurred_residuals_with, blurred_weight, deviation, residuals, Deviation,
+};
 use crate::optimize::Evaluation;
 use crate::raster::Image;
 use crate::render::RenderSession;
 use crate::scene::{ParamSpace, Scene};
+
+/// One photograph's side of a blurred comparison at one blur: its
+/// blurred levels, and the blurred weight of its mask (the divisor of
+/// every render's blur, the same for each).
+struct Blurred {
+    levels: Vec<f32>,
+    weight: Vec<f32>,
+}
 
 pub struct ShotsProblem<'a> {
     session: Box<dyn RenderSession>,
@@ -26,9 +36,10 @@ pub struct ShotsProblem<'a> {
     best: Option<(f64, Vec<Image>)>,
     failures: Vec<String>,
     failed_renders: usize,
-    /// Each target's blurred levels at the blur last asked for (a local
-    /// search asks for one blur over many batches).
-    blurred: Option<(u64, Vec<Vec<f32>>)>,
+    /// Each target's blurred levels and blurred mask weight at the blur
+    /// last asked for (a local search asks for one blur over many
+    /// batches).
+    blurred: Option<(u64, Vec<Blurred>)>,
 }
 
 impl<'a> ShotsProblem<'a> {
@@ -91,9 +102,9 @@ impl<'a> ShotsProblem<'a> {
         Evaluation::failed()
     }
 
-    /// Every target's levels blurred by `sigma` pixels, computed once per
-    /// blur.
-    fn blurred_targets(&mut self, sigma: f64) -> &[Vec<f32>] {
+    /// Every target's levels and mask weight blurred by `sigma` pixels,
+    /// computed once per blur.
+    fn blurred_targets(&mut self, sigma: f64) -> &[Blurred] {
         if self
             .blurred
             .as_ref()
@@ -102,7 +113,13 @@ impl<'a> ShotsProblem<'a> {
             let levels = self
                 .targets
                 .iter()
-                .map(|t| blurred_levels(&t.image, t.mask.as_ref(), sigma))
+                .map(|t| {
+                    let (w, h) = t.image.dimensions();
+                    Blurred {
+                        levels: blurred_levels(&t.image, t.mask.as_ref(), sigma),
+                        weight: blurred_weight(w, h, t.mask.as_ref(), sigma),
+                    }
+                })
                 .collect();
             self.blurred = Some((sigma.to_bits(), levels));
         }
@@ -114,8 +131,8 @@ impl<'a> ShotsProblem<'a> {
     fn residuals_of(&mut self, shot: usize, img: &Image, blur: f64) -> Vec<f32> {
         let t = self.targets[shot];
         if blur > 0.0 {
-            let target = &self.blurred_targets(blur)[shot];
-            blurred_residuals(target, img, t.mask.as_ref(), blur)
+            let b = &self.blurred_targets(blur)[shot];
+            blurred_residuals_with((&b.levels, &b.weight), img, t.mask.as_ref(), blur)
         } else {
             residuals(&t.image, img, t.mask.as_ref())
         }

@@ -60,18 +60,46 @@ fn pass(planes: &mut [Vec<f32>], width: usize, height: usize, k: &[f32], along_x
     }
 }
 
-/// The blurred 8-bit levels of `image` (3 per pixel, the image's order),
-/// averaged over the pixels `mask` counts (all when None): a Gaussian of
-/// `sigma` pixels, normalised by the counted weight under it. A pixel with
-/// no counted pixel within reach keeps 0.
-pub fn blurred_levels(image: &Image, mask: Option<&Mask>, sigma: f64) -> Vec<f32> {
-    let (width, height) = (image.width() as usize, image.height() as usize);
-    let raw = image.as_raw();
+/// 1 on each pixel of a `width` x `height` image that `mask` counts (all
+/// when None), 0 elsewhere.
+fn counted(width: usize, height: usize, mask: Option<&Mask>) -> Vec<f32> {
     let mut weight = vec![0f32; width * height];
     match mask {
         None => weight.fill(1.0),
         Some(m) => m.pixels().iter().for_each(|&p| weight[p as usize] = 1.0),
     }
+    weight
+}
+
+/// The counted weight under the Gaussian of `sigma` pixels at each pixel
+/// of a `width` x `height` image (`G * w`): the divisor of every blur
+/// under `mask`, the same for each render of one photograph, so a caller
+/// blurring many computes it once ([`blurred_residuals_with`]).
+pub fn blurred_weight(width: u32, height: u32, mask: Option<&Mask>, sigma: f64) -> Vec<f32> {
+    let (width, height) = (width as usize, height as usize);
+    let mut planes = vec![counted(width, height, mask)];
+    let k = kernel(sigma);
+    pass(&mut planes, width, height, &k, true);
+    pass(&mut planes, width, height, &k, false);
+    planes.pop().unwrap_or_default()
+}
+
+/// The blurred 8-bit levels of `image` (3 per pixel, the image's order),
+/// averaged over the pixels `mask` counts (all when None): a Gaussian of
+/// `sigma` pixels, normalised by the counted weight under it. A pixel with
+/// no counted pixel within reach keeps 0.
+pub fn blurred_levels(image: &Image, mask: Option<&Mask>, sigma: f64) -> Vec<f32> {
+    let weight = blurred_weight(image.width(), image.height(), mask, sigma);
+    levels_over(image, mask, sigma, &weight)
+}
+
+/// [`blurred_levels`] with the blurred weight given ([`blurred_weight`]
+/// of the same size, mask and blur): each plane is blurred on its own,
+/// so the values are the same bits.
+fn levels_over(image: &Image, mask: Option<&Mask>, sigma: f64, blurred: &[f32]) -> Vec<f32> {
+    let (width, height) = (image.width() as usize, image.height() as usize);
+    let raw = image.as_raw();
+    let weight = counted(width, height, mask);
     let mut planes: Vec<Vec<f32>> = (0..3)
         .map(|c| {
             (0..width * height)
@@ -79,13 +107,12 @@ pub fn blurred_levels(image: &Image, mask: Option<&Mask>, sigma: f64) -> Vec<f32
                 .collect()
         })
         .collect();
-    planes.push(weight);
     let k = kernel(sigma);
     pass(&mut planes, width, height, &k, true);
     pass(&mut planes, width, height, &k, false);
     let mut out = vec![0f32; 3 * width * height];
     for p in 0..width * height {
-        let w = planes[3][p];
+        let w = blurred[p];
         if w > 0.0 {
             for c in 0..3 {
                 out[3 * p + c] = planes[c][p] / w;
@@ -105,7 +132,20 @@ pub fn blurred_residuals(
     mask: Option<&Mask>,
     sigma: f64,
 ) -> Vec<f32> {
-    let r = blurred_levels(render, mask, sigma);
+    let weight = blurred_weight(render.width(), render.height(), mask, sigma);
+    blurred_residuals_with((target, &weight), render, mask, sigma)
+}
+
+/// [`blurred_residuals`] with the target's blurred levels and the blurred
+/// weight of `mask` given ([`blurred_weight`]), both computed once per
+/// photograph and blur rather than per render.
+pub fn blurred_residuals_with(
+    (target, weight): (&[f32], &[f32]),
+    render: &Image,
+    mask: Option<&Mask>,
+    sigma: f64,
+) -> Vec<f32> {
+    let r = levels_over(render, mask, sigma, weight);
     debug_assert_eq!(r.len(), target.len());
     match mask {
         None => r.iter().zip(target).map(|(a, b)| a - b).collect(),
@@ -169,5 +209,27 @@ mod tests {
         assert_eq!(same.len(), 3 * 20);
         assert!(same.iter().all(|&r| r == 0.0));
         assert!((target[3 * 4] - 100.0).abs() < 1e-3, "{}", target[3 * 4]);
+    }
+
+    /// The weight blurred once and reused gives the residuals of the
+    /// weight blurred with each render, bit for bit, with a mask and
+    /// without.
+    #[test]
+    fn a_weight_blurred_once_gives_the_same_residuals() {
+        let target = Image::from_fn(17, 9, |x, y| {
+            image::Rgb([(7 * x) as u8, (20 * y) as u8, 90])
+        });
+        let render = Image::from_fn(17, 9, |x, y| {
+            image::Rgb([(5 * x) as u8, (3 * x * y) as u8, 200])
+        });
+        let mask = Mask::from_pixels(17, 9, (0..153).filter(|p| p % 4 != 1).collect());
+        for mask in [None, Some(&mask)] {
+            let levels = blurred_levels(&target, mask, 1.5);
+            let weight = blurred_weight(17, 9, mask, 1.5);
+            let each = blurred_residuals(&levels, &render, mask, 1.5);
+            let once = blurred_residuals_with((&levels, &weight), &render, mask, 1.5);
+            assert!(each.iter().any(|&r| r != 0.0));
+            assert_eq!(each, once);
+        }
     }
 }

@@ -11,7 +11,7 @@
 pub mod blur;
 pub mod mask;
 
-pub use blur::{blurred_levels, blurred_residuals};
+pub use blur::{blurred_levels, blurred_residuals, blurred_residuals_with, blurred_weight};
 pub use mask::Mask;
 
 use crate::raster::Image;

@@ -354,15 +354,12 @@ impl Material {
 
     /// [`Material::map`], writable.
     pub fn map_mut(&mut self, kind: MapKind) -> Option<&mut TextureRef> {
-        match kind {
-            MapKind::Color => self.color_map.as_mut(),
-            MapKind::Specular => self.specular_map.as_mut(),
-            MapKind::Shininess => self.shininess_map.as_mut(),
-            MapKind::Normal => self.normal_map.as_mut(),
-        }
+        self.map_slot(kind).as_mut()
     }
 
-    /// The material's slot for a map of `kind` (to set or clear it).
+    /// The material's slot for a map of `kind` (to set or clear it): the
+    /// kind-to-field table written once for writing, as [`Material::map`]
+    /// writes it for reading (a shared borrow cannot come from this one).
     pub fn map_slot(&mut self, kind: MapKind) -> &mut Option<TextureRef> {
         match kind {
             MapKind::Color => &mut self.color_map,

@@ -43,6 +43,19 @@ pub fn json(path: &Path) -> serde_json::Value {
 pub mod texture_set;
 pub mod traps;
 
+/// Fits the set in `dir` through the CLI (`scenefit fit FIT... -o fit`),
+/// then diagnoses the fit (`scenefit diagnose fit -o diag DIAGNOSE...`),
+/// each asserted to succeed; diag/diagnosis.json.
+pub fn fit_and_diagnose(dir: &Path, fit: &[&str], diagnose: &[&str]) -> serde_json::Value {
+    let fit: Vec<&str> = [&["fit"][..], fit, &["-o", "fit"]].concat();
+    let diagnose: Vec<&str> = [&["diagnose", "fit", "-o", "diag"][..], diagnose].concat();
+    for args in [fit, diagnose] {
+        let o = scenefit(dir, &args);
+        assert!(o.status.success(), "{args:?}: {}", stderr(&o));
+    }
+    json(&dir.join("diag/diagnosis.json"))
+}
+
 /// The signature and header chunk of a PNG of `w` x `h`, nothing else.
 pub fn png_header(w: u32, h: u32) -> Vec<u8> {
     let mut chunk = b"IHDR".to_vec();
