@@ -108,15 +108,6 @@ fn fit_and_diagnose(dir: &Path, shots: bool) -> Value {
     common::fit_and_diagnose(dir, &fit, &["--max-effects", "1"])
 }
 
-fn accepted(d: &Value) -> Vec<String> {
-    d["accepted"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .filter_map(|v| v.as_str().map(String::from))
-        .collect()
-}
-
 /// The mean angle, degrees, between the fitted and the true directions
 /// from the ball's centre to the light.
 fn light_error(shots: &Value, key: &str, centre: [f64; 3], truth: &[[f64; 3]]) -> f64 {
@@ -147,7 +138,7 @@ fn a_planted_map_is_accepted_first_on_a_set_and_frees_the_lights() {
     let dir = tempfile::tempdir().unwrap();
     let (model, truth) = make_set(dir.path(), SHOTS, true, 0.0);
     let d = fit_and_diagnose(dir.path(), true);
-    let got = accepted(&d);
+    let got = common::accepted(&d);
     assert_eq!(got.first().map(String::as_str), Some("albedo_map"), "{d:#}");
     let before = d["deviation_before"]["average"].as_f64().unwrap();
     let after = d["deviation_after"]["average"].as_f64().unwrap();
@@ -213,7 +204,10 @@ fn noise_only_and_a_single_photograph_do_not_accept_the_map() {
     let dir = tempfile::tempdir().unwrap();
     make_set(dir.path(), SHOTS, false, 1.0);
     let d = fit_and_diagnose(dir.path(), true);
-    assert!(!accepted(&d).contains(&"albedo_map".to_string()), "{d:#}");
+    assert!(
+        !common::accepted(&d).contains(&"albedo_map".to_string()),
+        "{d:#}"
+    );
     let tried = d["candidates"].as_array().unwrap();
     assert!(
         tried.iter().any(|c| c["effect"] == "albedo_map"),
@@ -230,7 +224,10 @@ fn noise_only_and_a_single_photograph_do_not_accept_the_map() {
     make_set(one.path(), 1, true, 0.0);
     let d = fit_and_diagnose(one.path(), false);
     // One photograph gives no value two equations: nothing is solved.
-    assert!(!accepted(&d).contains(&"albedo_map".to_string()), "{d:#}");
+    assert!(
+        !common::accepted(&d).contains(&"albedo_map".to_string()),
+        "{d:#}"
+    );
 }
 
 #[test]

@@ -60,13 +60,6 @@ fn fit_and_diagnose(dir: &Path) -> serde_json::Value {
     common::fit_and_diagnose(dir, &fit, &[])
 }
 
-fn accepted(d: &serde_json::Value) -> Vec<String> {
-    let list = d["accepted"].as_array().expect("accepted is a list");
-    list.iter()
-        .filter_map(|v| v.as_str().map(String::from))
-        .collect()
-}
-
 /// Files holding linear values (trap9's seed, smaller: 6 photographs of
 /// 32x32; fit and diagnosis 94 s at load 10): the response's refit
 /// drops the SAD by a few per cent plainly, within reach of a blurred
@@ -82,7 +75,7 @@ fn the_texture_free_footing_takes_the_response_of_a_linear_trap() {
     };
     traps::write_sized(dir.path(), Kind::Matte { gamma: 1.0 }, 109, size);
     let d = fit_and_diagnose(dir.path());
-    let got = accepted(&d);
+    let got = common::accepted(&d);
     assert!(
         got.iter().any(|e| e == "camera_response"),
         "accepted {got:?}"
@@ -127,7 +120,7 @@ fn a_real_broad_lobe_takes_no_response() {
     let dir = tempfile::tempdir().unwrap();
     traps::write(dir.path(), Kind::Lobe, 200);
     let d = fit_and_diagnose(dir.path());
-    let got = accepted(&d);
+    let got = common::accepted(&d);
     assert!(
         !got.iter().any(|e| e == "camera_response"),
         "accepted {got:?}"

@@ -41,15 +41,6 @@ fn diagnosed(
     (tmp, dir, d, floors)
 }
 
-fn accepted(d: &Value) -> Vec<String> {
-    d["accepted"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .filter_map(|v| v.as_str().map(String::from))
-        .collect()
-}
-
 /// The measures of a diagnosed set, printed: colour error, deviation
 /// after ÷ before, held-out ÷ noise floor; returned in that order.
 fn measures(name: &str, surface: Surface, dir: &Path, d: &Value, floors: &[f64]) -> [f64; 3] {
@@ -63,7 +54,7 @@ fn measures(name: &str, surface: Surface, dir: &Path, d: &Value, floors: &[f64])
     println!(
         "{name}: accepted {:?}; colour error {err:.4} over {texels} texels seen by >= 3 photographs; \
          deviation {:.3} % -> {:.3} % (x{ratio:.2}); held-out {} {:.3} % -> {:.3} %, floor {:.3} % (x{held_ratio:.2})",
-        accepted(d),
+        common::accepted(d),
         d["deviation_before"]["average"],
         d["deviation_after"]["average"],
         held["name"],
@@ -79,7 +70,7 @@ fn measures(name: &str, surface: Surface, dir: &Path, d: &Value, floors: &[f64])
 /// written beside improved_scene.json (a grey linear PNG, named by a
 /// relative path).
 fn maps_accepted_in_order(d: &Value, dir: &Path) {
-    let a = accepted(d);
+    let a = common::accepted(d);
     let at = |e: &str| a.iter().position(|x| x == e);
     let (color, spec) = (at("albedo_map"), at("specular_map"));
     assert!(color.is_some() && spec.is_some(), "accepted {a:?}");
@@ -117,7 +108,7 @@ fn a_uniform_material_accepts_neither_map() {
     ] {
         let (_tmp, dir, d, floors) = diagnosed(surface, false, name);
         measures(name, surface, &dir, &d, &floors);
-        let a = accepted(&d);
+        let a = common::accepted(&d);
         assert!(
             !a.iter().any(|e| e == "albedo_map" || e == "specular_map"),
             "{name}: accepted {a:?}"

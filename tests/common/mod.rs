@@ -56,6 +56,14 @@ pub fn fit_and_diagnose(dir: &Path, fit: &[&str], diagnose: &[&str]) -> serde_js
     json(&dir.join("diag/diagnosis.json"))
 }
 
+/// The effects a diagnosis.json accepted, in order.
+pub fn accepted(d: &serde_json::Value) -> Vec<String> {
+    let list = d["accepted"].as_array().expect("accepted is a list");
+    list.iter()
+        .filter_map(|v| v.as_str().map(String::from))
+        .collect()
+}
+
 /// The signature and header chunk of a PNG of `w` x `h`, nothing else.
 pub fn png_header(w: u32, h: u32) -> Vec<u8> {
     let mut chunk = b"IHDR".to_vec();
