@@ -1,18 +1,34 @@
 //! The diagnosis on generated textured sets (`common/texture_set.rs`): a
 //! sphere and a plane, 10 photographs each with the camera and the light
 //! moving, the colour texture unknown and a second material region with a
-//! quarter of the specular strength. The colour map and then the specular
-//! map are accepted, the specular map written beside improved_scene.json
-//! and named by it; on the same surfaces with a uniform material neither
-//! map is. Each case prints its measures (colour error on texels seen by
-//! 3 photographs or more, deviation after ÷ before, held-out ÷ noise
-//! floor; docs/results.md records them).
+//! quarter of the specular strength. On the sphere the colour map and
+//! then the specular map are accepted, the specular map written beside
+//! improved_scene.json and named by it (on the plane not yet: its test is
+//! ignored, docs/results.md); on the same surfaces with a uniform
+//! material neither map is. Each case prints its measures (colour error
+//! on texels seen by 3 photographs or more, deviation after ÷ before,
+//! held-out ÷ noise floor; docs/results.md records them).
 
 mod common;
 
 use common::texture_set::{self, Surface};
 use serde_json::Value;
 use std::path::{Path, PathBuf};
+
+/// The diagnosis's budgets: two effects (the two maps the sets plant) and
+/// a short search per trial (each trial's refit starts from the fit), so
+/// that a set takes minutes, not an hour (docs/results.md, textured sets).
+const DIAGNOSE: [&str; 9] = [
+    "--max-effects",
+    "2",
+    "--population",
+    "8",
+    "--generations",
+    "6",
+    "--restart-generations",
+    "0",
+    "--overwrite",
+];
 
 /// Fits and diagnoses the set of `surface` in a fresh directory (or
 /// `TEXTURE_SET_KEEP/NAME`); the directory and diagnosis.json.
@@ -37,7 +53,7 @@ fn diagnosed(
         "--quiet",
         "--overwrite",
     ];
-    let d = common::fit_and_diagnose(&dir, &fit, &["--max-effects", "3", "--overwrite"]);
+    let d = common::fit_and_diagnose(&dir, &fit, &DIAGNOSE);
     (tmp, dir, d, floors)
 }
 
@@ -83,16 +99,23 @@ fn maps_accepted_in_order(d: &Value, dir: &Path) {
     assert_eq!(map["encoding"], "linear");
 }
 
+/// Also the two measures of issue 28 the sphere meets (docs/results.md):
+/// the colour map within 0.02 (mean absolute, linear) of the truth on the
+/// texels 3 photographs or more see, and the deviation after at most 30 %
+/// of before. The held-out photograph's ratio to its noise floor is
+/// printed, not asserted: about 3, where a map at the side chosen can at
+/// best reach 2.7 (docs/results.md).
 #[test]
-#[ignore = "not yet seen to pass: about an hour a set on the shared machine of 2026-11-27 (docs/results.md, specular map)"]
 fn a_textured_sphere_accepts_the_colour_map_then_the_specular_map() {
     let (_tmp, dir, d, floors) = diagnosed(Surface::Sphere, true, "sphere");
-    measures("sphere", Surface::Sphere, &dir, &d, &floors);
+    let [err, ratio, _] = measures("sphere", Surface::Sphere, &dir, &d, &floors);
     maps_accepted_in_order(&d, &dir);
+    assert!(err <= 0.02, "colour error {err}");
+    assert!(ratio <= 0.3, "deviation after / before {ratio}");
 }
 
 #[test]
-#[ignore = "not yet seen to pass: about an hour a set on the shared machine of 2026-11-27 (docs/results.md, specular map)"]
+#[ignore = "fails: the colour map is solved at side 16, too coarse for the checker, and no specular map is accepted (docs/results.md, textured sets)"]
 fn a_textured_plane_accepts_the_colour_map_then_the_specular_map() {
     let (_tmp, dir, d, floors) = diagnosed(Surface::Plane, true, "plane");
     measures("plane", Surface::Plane, &dir, &d, &floors);
@@ -100,7 +123,6 @@ fn a_textured_plane_accepts_the_colour_map_then_the_specular_map() {
 }
 
 #[test]
-#[ignore = "not yet seen to pass: about an hour a set on the shared machine of 2026-11-27 (docs/results.md, specular map)"]
 fn a_uniform_material_accepts_neither_map() {
     for (surface, name) in [
         (Surface::Sphere, "uniform_sphere"),
