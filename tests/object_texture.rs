@@ -6,6 +6,8 @@
 //! again; the map matches the true texture on the texels it solved, and
 //! the texels no photograph sees keep 1 (the scalar colour).
 
+mod common;
+
 use scenefit::render::{from_spec, render_one};
 use scenefit::scene::texture::{self, Encoding, TextureRef};
 use scenefit::scene::Scene;
@@ -121,16 +123,8 @@ fn a_texture_seen_by_three_cameras_is_solved_in_the_objects_frame() {
             "--quiet",
         ],
     );
-    let quick = [
-        "--population",
-        "8",
-        "--generations",
-        "6",
-        "--restart-generations",
-        "0",
-    ];
     let mut args = vec!["diagnose", "fit", "-o", "diag", "--max-effects", "1"];
-    args.extend(quick);
+    args.extend(common::QUICK_DIAGNOSE);
     run_ok(d, &args);
     let diagnosis = read_json(&d.join("diag/diagnosis.json"));
     assert_eq!(diagnosis["accepted"][0], "albedo_map", "{diagnosis:#}");

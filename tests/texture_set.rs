@@ -3,9 +3,8 @@
 //! moving, the colour texture unknown and a second material region with a
 //! quarter of the specular strength. On the sphere the colour map and
 //! then the specular map are accepted, the specular map written beside
-//! improved_scene.json and named by it (on the plane not yet: its test is
-//! ignored, docs/results.md); on the same surfaces with a uniform
-//! material neither map is. Each case prints its measures (colour error
+//! improved_scene.json and named by it; on the same surfaces with a
+//! uniform material neither map is. Each case prints its measures (colour error
 //! on texels seen by 3 photographs or more, deviation after ÷ before,
 //! held-out ÷ noise floor; docs/results.md records them).
 
@@ -15,20 +14,9 @@ use common::texture_set::{self, Surface};
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 
-/// The diagnosis's budgets: two effects (the two maps the sets plant) and
-/// a short search per trial (each trial's refit starts from the fit), so
-/// that a set takes minutes, not an hour (docs/results.md, textured sets).
-const DIAGNOSE: [&str; 9] = [
-    "--max-effects",
-    "2",
-    "--population",
-    "8",
-    "--generations",
-    "6",
-    "--restart-generations",
-    "0",
-    "--overwrite",
-];
+/// The diagnosis's budgets: two effects (the two maps the sets plant)
+/// and the short search of `common::QUICK_DIAGNOSE`.
+const EFFECTS: [&str; 3] = ["--max-effects", "2", "--overwrite"];
 
 /// Fits and diagnoses the set of `surface` in a fresh directory (or
 /// `TEXTURE_SET_KEEP/NAME`); the directory and diagnosis.json.
@@ -53,7 +41,8 @@ fn diagnosed(
         "--quiet",
         "--overwrite",
     ];
-    let d = common::fit_and_diagnose(&dir, &fit, &DIAGNOSE);
+    let diagnose = [&EFFECTS[..], &common::QUICK_DIAGNOSE].concat();
+    let d = common::fit_and_diagnose(&dir, &fit, &diagnose);
     (tmp, dir, d, floors)
 }
 
@@ -114,12 +103,16 @@ fn a_textured_sphere_accepts_the_colour_map_then_the_specular_map() {
     assert!(ratio <= 0.3, "deviation after / before {ratio}");
 }
 
+/// On the plane the deviation after is asserted (at most 30 % of before);
+/// the colour error is printed, not asserted: about 0.044 against the
+/// 0.02 asked (docs/results.md, "The map's side chosen by held-out
+/// prediction").
 #[test]
-#[ignore = "fails: the colour map is solved at side 16, too coarse for the checker, and no specular map is accepted (docs/results.md, textured sets)"]
 fn a_textured_plane_accepts_the_colour_map_then_the_specular_map() {
     let (_tmp, dir, d, floors) = diagnosed(Surface::Plane, true, "plane");
-    measures("plane", Surface::Plane, &dir, &d, &floors);
+    let [_, ratio, _] = measures("plane", Surface::Plane, &dir, &d, &floors);
     maps_accepted_in_order(&d, &dir);
+    assert!(ratio <= 0.3, "deviation after / before {ratio}");
 }
 
 #[test]

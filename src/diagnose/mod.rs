@@ -35,6 +35,7 @@ mod imitations;
 mod inputs;
 mod lanes;
 mod map_file;
+mod map_side;
 mod model;
 mod one_refit;
 pub mod photo;

@@ -43,6 +43,18 @@ pub fn json(path: &Path) -> serde_json::Value {
 pub mod texture_set;
 pub mod traps;
 
+/// A diagnosis's short search per trial (each trial's refit starts from
+/// the fit): for the tests that diagnose a generated set end to end, so
+/// that a set takes minutes, not an hour (docs/results.md, textured sets).
+pub const QUICK_DIAGNOSE: [&str; 6] = [
+    "--population",
+    "8",
+    "--generations",
+    "6",
+    "--restart-generations",
+    "0",
+];
+
 /// Fits the set in `dir` through the CLI (`scenefit fit FIT... -o fit`),
 /// then diagnoses the fit (`scenefit diagnose fit -o diag DIAGNOSE...`),
 /// each asserted to succeed; diag/diagnosis.json.
