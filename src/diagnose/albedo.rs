@@ -5,8 +5,8 @@
 //! texel, shared by every photograph and solved from all of them that see
 //! the texel, whatever the camera and light of each
 //! (`texels.rs`; the finest resolution the samples support in
-//! `texel_layout.rs`, the side kept chosen by held-out prediction in
-//! `map_side.rs`). No search could fit it. Values with evidence in fewer
+//! `texel_layout.rs`, the side kept chosen by the criterion in
+//! `solve_for`). No search could fit it. Values with evidence in fewer
 //! than two photographs stay 1 (the scalar colour) and are not counted,
 //! so on a single photograph nothing is solved and the effect is no
 //! candidate; nor are values whose drop of the SAD does not pay for them
@@ -20,9 +20,9 @@
 
 use super::effects::covered;
 use super::inputs::Params;
-use super::map_side;
 use super::model::{shots_of, Model};
 use super::refits::Refits;
+use super::selection::{delta_bic, overdispersion_of};
 use super::texel_layout::{layouts, Layout, MAX_MAP_SIDE};
 use super::texels::{self, Evidence};
 use crate::error::{Error, Result};
@@ -137,11 +137,12 @@ fn evidence<'a>(
 /// values solved, or None when no value could be solved.
 ///
 /// The finest side the samples support (`texel_layout.rs`) is a ceiling,
-/// not a choice: each side from it down (every object's side halved in
-/// turn) is scored by how well its maps predict photographs left out of
-/// their solve (`map_side.rs`, no render), and the maps are solved from
-/// every photograph at the best. A finer map thus buys its texels only
-/// where they predict what they were not fitted to; `--map-size` fixes
+/// not a choice: the maps are solved at it and at each coarser side in
+/// turn (every object's side halved), each model scored by the criterion
+/// the round applies (`selection::delta_bic`, with the overdispersion of
+/// the finest side's residuals), and the best kept; the search stops at
+/// the first side that scores worse than the finer one. A finer map thus buys its
+/// texels only where its drop in SAD pays for them; `--map-size` fixes
 /// the side instead.
 fn solve_for(
     fits: &mut Refits,
@@ -171,27 +172,30 @@ fn solve_for(
     if fits.config.map_size.is_some() {
         return written(fits, &ceiling);
     }
-    // From the ceiling down, each side scored by its prediction of the
-    // photographs left out of its solve; the search stops at the first
-    // side that predicts worse than the finer one (a tie goes to the
-    // coarser: fewer values for the same prediction).
-    let response = scene.camera.response;
-    let mut best: Option<(f64, Vec<Option<Layout>>)> = None;
+    let (n, sad0) = texels::totals(&evidence);
+    let mut best: Option<(f64, Solved)> = None;
+    let mut c = None;
     for shift in 0..=MAX_MAP_SIDE.trailing_zeros() {
         let sides = coarser(&ceiling, shift);
         if shift > 0 && sides == coarser(&ceiling, shift - 1) {
             break;
         }
-        let score = map_side::held_out_sad(&evidence, &sides, response, kind);
-        if best.as_ref().is_some_and(|b| score > b.0) {
+        let Some((s, count, _)) = written(fits, &sides)? else {
+            break;
+        };
+        let Some(m) = fits.model_of(s.clone(), own)? else {
+            break;
+        };
+        // One overdispersion for every side, the finest's: the most general
+        // model tried, as the round weighs its candidates (`selection::weigh`).
+        let c = *c.get_or_insert_with(|| overdispersion_of(&m, fits.inputs));
+        let score = delta_bic(sad0, m.sad, n, count, c);
+        if best.as_ref().is_some_and(|b| score >= b.0) {
             break;
         }
-        best = Some((score, sides));
+        best = Some((score, (s, count, sides)));
     }
-    match best {
-        Some((_, sides)) => written(fits, &sides),
-        None => Ok(None),
-    }
+    Ok(best.map(|(_, solved)| solved))
 }
 
 /// A solve's result: the scene naming the maps, the values solved, and
@@ -273,8 +277,8 @@ pub(super) fn solved(
 /// `model` with the maps solved for it as it stands (no refit), the files
 /// named by `tag`: the model without the albedo's part of its residual
 /// (`footing.rs`), and the layouts solved at — `at` when given (so two
-/// models are compared with the same map), else the side that predicts
-/// best (`map_side.rs`). None: no value could be solved. The model's renders are its
+/// models are compared with the same map), else the side the criterion
+/// keeps. None: no value could be solved. The model's renders are its
 /// lit evidence: they are not drawn again.
 pub(super) fn texture_free(
     fits: &mut Refits,

@@ -35,7 +35,6 @@ mod imitations;
 mod inputs;
 mod lanes;
 mod map_file;
-mod map_side;
 mod model;
 mod one_refit;
 pub mod photo;

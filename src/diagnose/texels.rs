@@ -77,10 +77,7 @@ pub struct ObjectMap {
 /// Per laid-out object, its samples in photograph and pixel order, one
 /// per pixel; and the criterion's N and SAD of the model without the
 /// maps over every counted pixel.
-pub(super) fn samples(
-    evidence: &[Evidence],
-    layouts: &[Option<Layout>],
-) -> (Vec<Vec<Sample>>, f64, f64) {
+fn samples(evidence: &[Evidence], layouts: &[Option<Layout>]) -> (Vec<Vec<Sample>>, f64, f64) {
     let mut out = vec![Vec::new(); layouts.len()];
     let (mut n, mut sad) = (0.0_f64, 0.0);
     for (k, e) in evidence.iter().enumerate() {
@@ -114,6 +111,13 @@ pub(super) fn samples(
     (out, n, sad)
 }
 
+/// The criterion's N (channel values counted over every photograph) and
+/// the SAD of the model without the maps over them.
+pub fn totals(evidence: &[Evidence]) -> (f64, f64) {
+    let (_, n, sad) = samples(evidence, &[]);
+    (n, sad)
+}
+
 /// Solves each laid-out object's map of `kind` from every photograph's
 /// evidence: a colour map per channel, a specular map one value per texel
 /// for the three (written grey).
@@ -128,20 +132,9 @@ pub fn solve(
     response: Option<Response>,
     kind: MapKind,
 ) -> Vec<ObjectMap> {
-    let (samples, n, sad) = samples(evidence, layouts);
-    solve_samples(&samples, layouts, (n, sad), &Levels::new(response), kind)
-}
-
-/// `solve` from the samples of each object, with the criterion's N and
-/// SAD (`totals`) that price a value.
-pub(super) fn solve_samples(
-    samples: &[Vec<Sample>],
-    layouts: &[Option<Layout>],
-    (n, sad): (f64, f64),
-    levels: &Levels,
-    kind: MapKind,
-) -> Vec<ObjectMap> {
+    let levels = Levels::new(response);
     let scalar = kind == MapKind::Specular;
+    let (samples, n, sad) = samples(evidence, layouts);
     // A colour map's texel is pinned by its object's other texels (seen
     // by two photographs or more); a highlight is pinned only by another.
     // A scalar map's one value is fitted to the three channels together.
@@ -156,7 +149,7 @@ pub(super) fn solve_samples(
         f64::INFINITY
     };
     let mut maps = Vec::new();
-    for (object, (layout, samples)) in layouts.iter().zip(samples).enumerate() {
+    for (object, (layout, samples)) in layouts.iter().zip(&samples).enumerate() {
         let Some(layout) = *layout else { continue };
         if photographs(samples) < MIN_PHOTOGRAPHS {
             continue;
@@ -166,7 +159,7 @@ pub(super) fn solve_samples(
         let mut count = 0;
         for channels in fits {
             let rule = (cost, per_texel);
-            let Fitted { m, kept } = fit_channels(samples, channels.clone(), texels, levels, rule);
+            let Fitted { m, kept } = fit_channels(samples, channels.clone(), texels, &levels, rule);
             // One value counted per texel and fit: a scalar map's is one.
             for k in (0..texels).filter(|&k| kept[k]) {
                 values[3 * k..3 * k + 3][channels.clone()].fill(m[k] as f32);
