@@ -14,8 +14,10 @@
 //!
 //! The map is solved, the model's other free parameters refitted with it
 //! in the scene, and the map solved once more against the refitted model
-//! (the better of the two kept). Its parameters for the criterion are the
-//! values solved, ln N each. The maps are written into the diagnosis
+//! (the better of the two kept); a specular map is then solved once more
+//! with an exponent per texel beside it (`gloss.rs`), kept when that
+//! pays. Its parameters for the criterion are the values solved, ln N
+//! each. The maps are written into the diagnosis
 //! directory as 16-bit linear PNG (`map_file.rs`, which names them).
 
 use super::effects::covered;
@@ -35,7 +37,7 @@ use crate::scene::Scene;
 use std::path::{Path, PathBuf};
 
 /// `scene` with each `(object, map)` set as that object's map of `kind`.
-fn with_maps(scene: &Scene, maps: &[(usize, TextureRef)], kind: MapKind) -> Scene {
+pub(super) fn with_maps(scene: &Scene, maps: &[(usize, TextureRef)], kind: MapKind) -> Scene {
     let mut s = scene.clone();
     for (o, t) in maps {
         *s.objects[*o].material.map_slot(kind) = Some(t.clone());
@@ -59,7 +61,8 @@ pub fn prune(out: &Path, kept: &Scene) {
             let m = &o.material;
             let file = |t: Option<&TextureRef>| t.map(|t| t.file().to_string());
             let color = file(m.color_map.as_ref());
-            [m.albedo_map.clone(), color, file(m.specular_map.as_ref())]
+            let (specular, shininess) = (m.specular_map.as_ref(), m.shininess_map.as_ref());
+            [m.albedo_map.clone(), color, file(specular), file(shininess)]
         })
         .flatten()
         .map(PathBuf::from)
@@ -85,7 +88,7 @@ pub fn prune(out: &Path, kept: &Scene) {
 /// strengths, by `kind`) as they are (`lit`: `held` when the caller
 /// already holds those renders) and at 0 (`dark`), and the surface pass
 /// of its camera.
-fn evidence<'a>(
+pub(super) fn evidence<'a>(
     fits: &mut Refits<'a>,
     scene: &Scene,
     own: &[Params],
@@ -240,8 +243,9 @@ fn written_maps(
 
 /// The model with the maps of `kind` (`albedo_map`, `specular_map`):
 /// solved, the others refitted (`Refits::after_solve`), solved again, the
-/// better of the two kept; the model and the values solved (None: nothing
-/// could be solved).
+/// better of the two kept, a specular map's exponent per texel beside it
+/// when that pays (`gloss.rs`); the model and the values solved (None:
+/// nothing could be solved).
 pub(super) fn solved(
     fits: &mut Refits,
     model: &Model,
@@ -252,23 +256,31 @@ pub(super) fn solved(
     // The model's renders are its lit evidence: not drawn again.
     let held = Some(&model.images[..]);
     let solve = solve_for(fits, &model.scene, &model.own, held, (kind, &first), None)?;
-    let Some((scene, count1, _)) = solve else {
+    let Some((scene, count1, layouts1)) = solve else {
         return Ok(None);
     };
     // The losing map stays on disk until the diagnosis prunes every map
     // its final model does not name (`prune`).
     let (mut fitted, mut count) = (fits.after_solve(&scene, &model.own)?, count1);
+    let mut layouts = layouts1;
     // Solved again on the refitted model without the first map: the
     // objects it covered are covered again.
     let bare = without_maps(&fitted.scene, &scene, &model.scene, kind);
     let tag = format!("round{round}");
     let again = solve_for(fits, &bare, &fitted.own, None, (kind, &tag), None)?;
-    if let Some((again, count2, _)) = again {
+    if let Some((again, count2, layouts2)) = again {
         let own = fitted.own.clone();
         if let Some(m) = fits.model_of(again, &own)? {
             if m.sad < fitted.sad {
-                (fitted, count) = (m, count2);
+                (fitted, count, layouts) = (m, count2, layouts2);
             }
+        }
+    }
+    if kind == MapKind::Specular {
+        let tag = format!("round{round}_gloss");
+        let shine = super::gloss::beside(fits, &fitted, &model.scene, &layouts, (count, &tag))?;
+        if let Some(better) = shine {
+            return Ok(Some(better));
         }
     }
     Ok(Some((fitted, count)))
@@ -296,7 +308,7 @@ pub(super) fn texture_free(
 }
 
 /// `scene` with the maps of `kind` that `with` added to `without` removed.
-fn without_maps(scene: &Scene, with: &Scene, without: &Scene, kind: MapKind) -> Scene {
+pub(super) fn without_maps(scene: &Scene, with: &Scene, without: &Scene, kind: MapKind) -> Scene {
     let mut s = scene.clone();
     for (o, (a, b)) in s
         .objects

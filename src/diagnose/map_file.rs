@@ -53,19 +53,25 @@ pub fn write(path: &Path, map: &ObjectMap) -> Result<TextureRef> {
 /// of the effect that solves it ([`effects::Effect::map_kind`]): the one table
 /// the file names are read from, so a new map effect needs no edit here.
 fn solved_kinds() -> impl Iterator<Item = (MapKind, &'static str)> {
-    effects::ALL
-        .iter()
-        .filter_map(|e| e.map_kind().map(|k| (k, e.name())))
+    effects::ALL.iter().flat_map(|e| {
+        let name = e.name();
+        e.written_kinds().into_iter().map(move |k| (k, name))
+    })
 }
 
 /// The prefix of every file of a map of `kind` the diagnosis writes: the
-/// name of the effect that solves it; an error for a kind no effect
-/// solves (no file of it is ever written).
+/// name of the effect that solves it, and the kind's key when the effect
+/// writes it beside its own kind (`specular_map_shininess_map_…`); an
+/// error for a kind no effect solves (no file of it is ever written).
 fn prefix(kind: MapKind) -> Result<String> {
-    solved_kinds()
+    let (_, name) = solved_kinds()
         .find(|&(k, _)| k == kind)
-        .map(|(_, name)| format!("{name}_"))
-        .ok_or_else(|| Error::Run(format!("no effect solves a {}", kind.key())))
+        .ok_or_else(|| Error::Run(format!("no effect solves a {}", kind.key())))?;
+    let own = effects::by_name(name).and_then(|e| e.map_kind()) == Some(kind);
+    Ok(match own {
+        true => format!("{name}_"),
+        false => format!("{name}_{}_", kind.key()),
+    })
 }
 
 /// True when `name` is a map file the diagnosis writes (of any kind).
@@ -121,7 +127,8 @@ mod tests {
     use super::*;
 
     /// The names outside scripts read: for every kind, the map files of
-    /// the effect that solves it, or none when no effect does.
+    /// the effect that solves it (a shininess map is written beside the
+    /// specular map, and named so), or none when no effect does.
     #[test]
     fn every_map_kind_names_its_files_as_before() {
         let dir = tempfile::tempdir().unwrap();
@@ -130,7 +137,8 @@ mod tests {
             let expected = match kind {
                 MapKind::Color => Some("albedo_map_"),
                 MapKind::Specular => Some("specular_map_"),
-                MapKind::Shininess | MapKind::Normal => None,
+                MapKind::Shininess => Some("specular_map_shininess_map_"),
+                MapKind::Normal => None,
             };
             let file = path(out, kind, "round2", 1, 64);
             let zero = zero(out, kind);

@@ -30,6 +30,7 @@ mod diagnosis;
 pub mod effects;
 pub mod features;
 mod footing;
+mod gloss;
 mod held;
 mod imitations;
 mod inputs;

@@ -72,6 +72,10 @@ const SWEEPS: usize = 30;
 pub struct Fitted {
     pub m: Vec<f64>,
     pub kept: Vec<bool>,
+    /// Each texel's cell's SAD in levels over the channels fitted, as
+    /// `m` predicts it (1 where not kept): what another solve of the same
+    /// samples is compared with, texel by texel (`diagnose/gloss.rs`).
+    pub cell_sad: Vec<f64>,
 }
 
 /// One sample's equation in channel `c`: the map's reach `a` (lit - dark),
@@ -158,13 +162,18 @@ pub fn fit_channels(
     for _ in 0..SWEEPS {
         sweep(samples, &eq, &touch, &active, &mut m, &mut p);
     }
-    let kept = keep(samples, channels, levels, &cells, &active, &p, cost);
+    let sads = cell_sads(samples, channels, levels, &cells, &p);
+    let kept: Vec<bool> = (0..texels)
+        .map(|k| active[k] && sads[k].0 - sads[k].1 > cost)
+        .collect();
+    let mut cell_sad = Vec::with_capacity(texels);
     for k in 0..texels {
         if !kept[k] {
             m[k] = 1.0;
         }
+        cell_sad.push(if kept[k] { sads[k].1 } else { sads[k].0 });
     }
-    Fitted { m, kept }
+    Fitted { m, kept, cell_sad }
 }
 
 /// Marks the texels with evidence from `min_photos` photographs and
@@ -235,34 +244,30 @@ fn sweep(
     }
 }
 
-/// The active texels whose cell's samples, predicted through the fitted
-/// lookups `p`, drop their SAD in levels over `channels` by more than
-/// `cost`.
-fn keep(
+/// Each texel's cell's SAD in levels over `channels`: at the scalar
+/// value (the lit render) and predicted through the fitted lookups `p`.
+/// A texel is kept when the drop from the one to the other is more than
+/// the cost of its value.
+fn cell_sads(
     samples: &[Sample],
     channels: Range<usize>,
     levels: &Levels,
     (start, list): &(Vec<usize>, Vec<u32>),
-    active: &[bool],
     p: &[f64],
-    cost: f64,
-) -> Vec<bool> {
+) -> Vec<(f64, f64)> {
     let lin = &levels.linear;
-    (0..active.len())
+    (0..start.len() - 1)
         .map(|k| {
-            active[k] && {
-                let drop: f64 = list[start[k]..start[k + 1]]
-                    .iter()
-                    .flat_map(|&s| channels.clone().map(move |c| (s as usize, c)))
-                    .map(|(s, c)| {
-                        let [t, l, d] = samples[s].levels[c];
-                        let (ll, dl) = (lin[l as usize], lin[d as usize]);
-                        let predicted = levels.level(dl + p[s] * (ll - dl));
-                        t.abs_diff(l) as f64 - t.abs_diff(predicted) as f64
-                    })
-                    .sum();
-                drop > cost
-            }
+            list[start[k]..start[k + 1]]
+                .iter()
+                .flat_map(|&s| channels.clone().map(move |c| (s as usize, c)))
+                .map(|(s, c)| {
+                    let [t, l, d] = samples[s].levels[c];
+                    let (ll, dl) = (lin[l as usize], lin[d as usize]);
+                    let predicted = levels.level(dl + p[s] * (ll - dl));
+                    (t.abs_diff(l) as f64, t.abs_diff(predicted) as f64)
+                })
+                .fold((0.0, 0.0), |a, b| (a.0 + b.0, a.1 + b.1))
         })
         .collect()
 }

@@ -72,6 +72,9 @@ pub struct ObjectMap {
     pub layout: Layout,
     pub values: Vec<f32>,
     pub count: usize,
+    /// Each texel's cell's SAD in levels over the three channels, as the
+    /// map predicts it (`texel_fit::Fitted::cell_sad`).
+    pub cell_sad: Vec<f64>,
 }
 
 /// Per laid-out object, its samples in photograph and pixel order, one
@@ -118,6 +121,17 @@ pub fn totals(evidence: &[Evidence]) -> (f64, f64) {
     (n, sad)
 }
 
+/// What a solved value costs in levels of SAD, by the criterion over `n`
+/// channel values whose SAD without the maps is `sad`: `ln N SAD / 2N`
+/// (infinite with nothing counted; `solve` says why).
+pub fn value_cost(n: f64, sad: f64) -> f64 {
+    if n > 1.0 {
+        sad * n.ln() / (2.0 * n)
+    } else {
+        f64::INFINITY
+    }
+}
+
 /// Solves each laid-out object's map of `kind` from every photograph's
 /// evidence: a colour map per channel, a specular map one value per texel
 /// for the three (written grey).
@@ -143,11 +157,7 @@ pub fn solve(
     } else {
         (PER_CHANNEL, 1)
     };
-    let cost = if n > 1.0 {
-        sad * n.ln() / (2.0 * n)
-    } else {
-        f64::INFINITY
-    };
+    let cost = value_cost(n, sad);
     let mut maps = Vec::new();
     for (object, (layout, samples)) in layouts.iter().zip(&samples).enumerate() {
         let Some(layout) = *layout else { continue };
@@ -157,9 +167,14 @@ pub fn solve(
         let texels = (layout.side * layout.side) as usize;
         let mut values = vec![1.0_f32; 3 * texels];
         let mut count = 0;
+        let mut cell_sad = vec![0.0; texels];
         for channels in fits {
             let rule = (cost, per_texel);
-            let Fitted { m, kept } = fit_channels(samples, channels.clone(), texels, &levels, rule);
+            let fitted = fit_channels(samples, channels.clone(), texels, &levels, rule);
+            let Fitted { m, kept, .. } = &fitted;
+            for (a, b) in cell_sad.iter_mut().zip(&fitted.cell_sad) {
+                *a += b;
+            }
             // One value counted per texel and fit: a scalar map's is one.
             for k in (0..texels).filter(|&k| kept[k]) {
                 values[3 * k..3 * k + 3][channels.clone()].fill(m[k] as f32);
@@ -172,6 +187,7 @@ pub fn solve(
                 layout,
                 values,
                 count,
+                cell_sad,
             });
         }
     }

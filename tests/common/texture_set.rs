@@ -26,6 +26,9 @@ pub const SHOTS: usize = 10;
 pub const SIGMA: f64 = 1.0;
 /// The region of lower gloss: its specular strength times this.
 pub const LOW_GLOSS: f64 = 0.25;
+/// The glossy set's exponents: the second region's broad lobe, the
+/// rest's (the model's scalar).
+pub const EXPONENTS: (f64, f64) = (10.0, 40.0);
 /// A plane's texture tile, metres.
 const TILE: f64 = 2.4;
 
@@ -121,12 +124,24 @@ pub fn shot(surface: Surface, i: usize) -> ([f64; 3], [f64; 3]) {
     }
 }
 
-/// The truth: the model with the true material (textured or uniform),
-/// its maps written into `dir`.
-fn truth(dir: &Path, surface: Surface, textured: bool) -> Scene {
+/// What varies over the true material.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Truth {
+    /// Nothing: one colour, one specular strength.
+    Uniform,
+    /// The colour, and the specular strength (`gloss_at`).
+    Textured,
+    /// The colour, and the exponent: the second region's lobe broad
+    /// (`EXPONENTS`), the strength the same everywhere.
+    Glossy,
+}
+
+/// The truth: the model with the true material, its maps written into
+/// `dir`.
+fn truth(dir: &Path, surface: Surface, kind: Truth) -> Scene {
     let mut t = model(surface);
     let m = &mut t["objects"][0]["material"];
-    if textured {
+    if kind != Truth::Uniform {
         let scale = match surface {
             Surface::Sphere => json!([1.0, 1.0]),
             Surface::Plane => json!([1.0 / TILE, 1.0 / TILE]),
@@ -141,7 +156,21 @@ fn truth(dir: &Path, surface: Surface, textured: bool) -> Scene {
         m["specular"] = json!(0.6);
         let map = |f: &str| json!({"file": dir.join(f), "encoding": "linear", "scale": scale});
         m["color_map"] = map("truth_color.png");
-        m["specular_map"] = map("truth_specular.png");
+        if kind == Truth::Textured {
+            m["specular_map"] = map("truth_specular.png");
+        } else {
+            let (broad, rest) = EXPONENTS;
+            write_texture(&dir.join("truth_shininess.png"), (96, 48), |uv| {
+                [if gloss_at(surface, uv) < 1.0 {
+                    broad / rest
+                } else {
+                    1.0
+                }; 3]
+            });
+            let mut shine = map("truth_shininess.png");
+            shine["range"] = json!([0.0, rest]);
+            m["shininess_map"] = shine;
+        }
     } else {
         m["color"] = json!([0.7, 0.5, 0.4]);
         m["specular"] = json!(0.4);
@@ -172,7 +201,17 @@ fn shot_scene(truth: &Scene, surface: Surface, i: usize) -> Scene {
 /// true maps); each photograph's noise floor (its deviation from the
 /// noise-free render), in percent.
 pub fn write(dir: &Path, surface: Surface, textured: bool) -> Vec<f64> {
-    let truth = truth(dir, surface, textured);
+    let kind = if textured {
+        Truth::Textured
+    } else {
+        Truth::Uniform
+    };
+    write_truth(dir, surface, kind)
+}
+
+/// [`write`] of the material `kind`.
+pub fn write_truth(dir: &Path, surface: Surface, kind: Truth) -> Vec<f64> {
+    let truth = truth(dir, surface, kind);
     let phong = from_spec("phong").unwrap();
     let (mut list, mut floors) = (Vec::new(), Vec::new());
     for i in 0..SHOTS {
@@ -247,4 +286,43 @@ pub fn colour_error(improved: &Scene, surface: Surface) -> (f64, usize) {
         counted += 1;
     }
     (err / counted.max(1) as f64, counted)
+}
+
+/// The median exponent of `improved`'s shininess map (a loaded scene,
+/// the sphere's parametrisation: uv the tile's) over the texels the
+/// diagnosis solved (an exponent off the scalar, or a specular strength
+/// off 1), in the broad region and in the rest.
+pub fn shininess_by_region(improved: &Scene, surface: Surface) -> [f64; 2] {
+    let m = &improved.objects[0].material;
+    let read = |t: &texture::TextureRef| {
+        let texels = texture::get(Path::new(t.file()), Encoding::Linear).unwrap();
+        let hi = t.range()[1];
+        (texels, hi)
+    };
+    let (shine, hi) = read(m.shininess_map.as_ref().expect("a shininess map"));
+    let strength = m.specular_map.as_ref().map(read);
+    let (w, h) = (shine.width as usize, shine.height as usize);
+    let mut regions = [Vec::new(), Vec::new()];
+    for y in 0..h {
+        for x in 0..w {
+            let k = 3 * (y * w + x);
+            let e = shine.values[k] as f64 * hi;
+            let moved = (e - m.shininess).abs() > 1e-3 * m.shininess;
+            let solved = strength
+                .as_ref()
+                .is_some_and(|(t, hi)| (t.values[k] as f64 * hi - 1.0).abs() > 1e-3);
+            if !moved && !solved {
+                continue;
+            }
+            let uv = [
+                (x as f64 + 0.5) / w as f64,
+                1.0 - (y as f64 + 0.5) / h as f64,
+            ];
+            regions[usize::from(gloss_at(surface, uv) >= 1.0)].push(e);
+        }
+    }
+    regions.map(|mut r| {
+        r.sort_by(f64::total_cmp);
+        r.get(r.len() / 2).copied().unwrap_or(f64::NAN)
+    })
 }

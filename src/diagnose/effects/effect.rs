@@ -52,6 +52,13 @@ pub trait Effect: Sync {
         None
     }
 
+    /// Every kind of texture the effect's solve may write: its
+    /// [`Effect::map_kind`] first, then any it solves beside it
+    /// (`specular_map` a shininess map where the highlights' widths vary).
+    fn written_kinds(&self) -> Vec<MapKind> {
+        self.map_kind().into_iter().collect()
+    }
+
     /// True for an effect solved in closed form rather than searched (a
     /// map: [`Effect::map_kind`]); its `extend` adds no free entries.
     fn closed_form(&self) -> bool {

@@ -4,7 +4,10 @@
 //! every photograph. A render is linear in it, so it is solved in closed
 //! form per texel from the highlights every photograph of a set puts on
 //! the texel (`diagnose/albedo.rs`), not searched; texels no highlight
-//! constrains keep the scalar strength.
+//! constrains keep the scalar strength. Where the highlights' widths
+//! vary too, a shininess per texel is solved beside the strength
+//! (`material.shininess_map`, `diagnose/gloss.rs`), kept only when it
+//! pays for its values.
 
 use super::albedo_map::covered;
 use super::Effect;
@@ -34,5 +37,11 @@ impl Effect for SpecularMap {
 
     fn map_kind(&self) -> Option<MapKind> {
         Some(MapKind::Specular)
+    }
+
+    /// A shininess map beside the strength where the highlights' widths
+    /// vary over the surface (`diagnose/gloss.rs`).
+    fn written_kinds(&self) -> Vec<MapKind> {
+        vec![MapKind::Specular, MapKind::Shininess]
     }
 }
