@@ -22,33 +22,18 @@
 
 use super::effects::covered;
 use super::inputs::Params;
-use super::model::{shots_of, Model};
+use super::map_evidence::{evidence, with_maps, without_maps};
+use super::model::Model;
 use super::refits::Refits;
 use super::selection::{delta_bic, overdispersion_of};
 use super::texel_layout::{layouts, Layout, MAX_MAP_SIDE};
 use super::texels::{self, Evidence};
 use crate::error::{Error, Result};
-use crate::fit::set::shots::Shot;
 use crate::metric::Mask;
 use crate::raster::Image;
-use crate::render::surface_coords;
 use crate::scene::texture::{MapKind, TextureRef};
 use crate::scene::Scene;
 use std::path::{Path, PathBuf};
-
-/// `scene` with each `(object, map)` set as that object's map of `kind`.
-pub(super) fn with_maps(scene: &Scene, maps: &[(usize, TextureRef)], kind: MapKind) -> Scene {
-    let mut s = scene.clone();
-    for (o, t) in maps {
-        *s.objects[*o].material.map_slot(kind) = Some(t.clone());
-    }
-    s
-}
-
-/// Removes the map file a model no longer names.
-fn discard(path: &Path) {
-    let _ = std::fs::remove_file(path);
-}
 
 /// Removes from `out` every map file the diagnosis wrote that `kept` (its
 /// final model) does not name: the maps of rejected candidates and the
@@ -78,61 +63,9 @@ pub fn prune(out: &Path, kept: &Scene) {
         let path = e.path();
         let absolute = std::path::absolute(&path).unwrap_or(path.clone());
         if !named.iter().any(|n| n == &absolute || n == &path) {
-            discard(&path);
+            super::map_file::discard(&path);
         }
     }
-}
-
-/// Each photograph's evidence for `scene` with its `own` values: its
-/// model rendered with the covered objects' colours (or specular
-/// strengths, by `kind`) as they are (`lit`: `held` when the caller
-/// already holds those renders) and at 0 (`dark`), and the surface pass
-/// of its camera.
-pub(super) fn evidence<'a>(
-    fits: &mut Refits<'a>,
-    scene: &Scene,
-    own: &[Params],
-    covered: &[bool],
-    held: Option<&[Image]>,
-    kind: MapKind,
-) -> Result<Vec<Evidence<'a>>> {
-    let inputs = fits.inputs;
-    let (zero_path, zero) = super::map_file::zero(fits.out, kind)?;
-    let probe: Vec<(usize, TextureRef)> = (0..covered.len())
-        .filter(|&o| covered[o])
-        .map(|o| (o, zero.clone()))
-        .collect();
-    let dark_scene = with_maps(scene, &probe, kind);
-    let rendered = |fits: &mut Refits, s: &Scene| -> Result<(Vec<Shot>, Vec<Image>)> {
-        let shots: Vec<Shot> = shots_of(s, inputs, own)?;
-        let images = fits.render(&shots)?.map(|(images, _)| images);
-        let images = images.ok_or_else(|| {
-            Error::Run(format!(
-                "{}: a render of the photographs failed",
-                kind.key()
-            ))
-        })?;
-        Ok((shots, images))
-    };
-    let (shots, lit) = match held {
-        Some(images) => (shots_of(scene, inputs, own)?, images.to_vec()),
-        None => rendered(fits, scene)?,
-    };
-    let dark = rendered(fits, &dark_scene);
-    discard(&zero_path);
-    let (_, dark) = dark?;
-    Ok(inputs
-        .shots
-        .iter()
-        .zip(shots.iter().zip(lit.into_iter().zip(dark)))
-        .map(|(s, (shot, (lit, dark)))| Evidence {
-            target: &s.target.image,
-            mask: s.target.mask.as_ref(),
-            lit,
-            dark,
-            coords: surface_coords(&shot.scene),
-        })
-        .collect())
 }
 
 /// The maps solved for `scene` with each photograph's `own` values,
@@ -305,19 +238,4 @@ pub(super) fn texture_free(
         return Ok(None);
     };
     Ok(fits.model_of(scene, &model.own)?.map(|m| (m, layouts)))
-}
-
-/// `scene` with the maps of `kind` that `with` added to `without` removed.
-pub(super) fn without_maps(scene: &Scene, with: &Scene, without: &Scene, kind: MapKind) -> Scene {
-    let mut s = scene.clone();
-    for (o, (a, b)) in s
-        .objects
-        .iter_mut()
-        .zip(with.objects.iter().zip(&without.objects))
-    {
-        if a.material.map(kind) != b.material.map(kind) {
-            *o.material.map_slot(kind) = b.material.map(kind).cloned();
-        }
-    }
-    s
 }

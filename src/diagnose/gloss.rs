@@ -15,8 +15,8 @@
 //! shininess map kept only when the criterion pays for its values; the
 //! caller (`albedo::solved`) weighs the effect on that model.
 
-use super::albedo::{evidence, with_maps, without_maps};
 use super::effects::covered;
+use super::map_evidence::{evidence, with_maps, without_maps};
 use super::model::Model;
 use super::refits::Refits;
 use super::selection::{delta_bic, overdispersion_of};

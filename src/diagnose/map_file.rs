@@ -91,6 +91,12 @@ pub fn path(out: &Path, kind: MapKind, tag: &str, object: usize, side: u32) -> R
     Ok(std::path::absolute(&p).unwrap_or(p))
 }
 
+/// Removes a map file no model names any longer (best effort: a file
+/// already gone is what was asked).
+pub fn discard(path: &Path) {
+    let _ = std::fs::remove_file(path);
+}
+
 /// Writes the zero map of `kind` (one texel) into `out`; its reference.
 pub fn zero(out: &Path, kind: MapKind) -> Result<(PathBuf, TextureRef)> {
     let path = out.join(format!("{}zero.png", prefix(kind)?));

@@ -35,6 +35,7 @@ mod held;
 mod imitations;
 mod inputs;
 mod lanes;
+mod map_evidence;
 mod map_file;
 mod model;
 mod one_refit;
