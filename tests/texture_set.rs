@@ -19,7 +19,7 @@ use std::path::{Path, PathBuf};
 
 /// The diagnosis's budgets: two effects (the two maps the sets plant)
 /// and the short search of `common::QUICK_DIAGNOSE`.
-const EFFECTS: [&str; 3] = ["--max-effects", "2", "--overwrite"];
+const EFFECTS: [&str; 2] = ["--max-effects", "2"];
 
 /// Fits and diagnoses the set of `surface` in a fresh directory (or
 /// `TEXTURE_SET_KEEP/NAME`); the directory and diagnosis.json.
@@ -44,7 +44,7 @@ fn diagnosed(
         "--quiet",
         "--overwrite",
     ];
-    let diagnose = [&EFFECTS[..], &common::QUICK_DIAGNOSE].concat();
+    let diagnose = [&EFFECTS[..], &["--overwrite"], &common::QUICK_DIAGNOSE].concat();
     let d = common::fit_and_diagnose(&dir, &fit, &diagnose);
     (tmp, dir, d, floors)
 }

@@ -7,7 +7,8 @@
 //! A render is not linear in the exponent, so the exponent is not solved
 //! like the strength (`texels.rs`): the strength map is solved again with
 //! the scalar exponent moved over a grid around its value (× 2^(j/2),
-//! `STEPS` each way), one set of lit renders per grid value, and each
+//! `STEPS` each way), one set of lit renders per grid value (the dark
+//! renders and surface passes, blind to the exponent, drawn once), and each
 //! texel takes the grid value whose solve predicts its own pixels best,
 //! charged for its values as `texels.rs` charges a strength (an exponent
 //! other than the scalar is one value more). The texels that keep the
@@ -16,7 +17,7 @@
 //! caller (`albedo::solved`) weighs the effect on that model.
 
 use super::effects::covered;
-use super::map_evidence::{evidence, with_maps, without_maps};
+use super::map_evidence::{evidence, rendered, with_maps, without_maps};
 use super::model::Model;
 use super::refits::Refits;
 use super::selection::{delta_bic, overdispersion_of};
@@ -62,18 +63,27 @@ pub(super) fn beside(
         return Ok(None);
     }
     let response = bare.camera.response;
-    let mut solves: Vec<Vec<ObjectMap>> = Vec::new();
-    let mut totals = (0.0, 0.0);
-    for j in -STEPS..=STEPS {
+    let at = |j: i32| {
         let mut scene = bare.clone();
         for (o, _) in mapped.iter().enumerate().filter(|m| *m.1) {
             let m = &mut scene.objects[o].material;
             m.shininess = exponent(bare.objects[o].material.shininess, j);
         }
-        let ev = evidence(fits, &scene, &model.own, &mapped, None, kind)?;
+        scene
+    };
+    // The dark renders (strength 0) and the surface passes do not see the
+    // exponent: drawn once, at the scalar; each step redraws only the lit.
+    let mut ev = evidence(fits, &at(0), &model.own, &mapped, None, kind)?;
+    let totals = texels::totals(&ev);
+    let mut centre = texels::solve(&ev, layouts, response, kind);
+    let mut solves: Vec<Vec<ObjectMap>> = Vec::new();
+    for j in -STEPS..=STEPS {
         if j == 0 {
-            totals = texels::totals(&ev);
+            solves.push(std::mem::take(&mut centre));
+            continue;
         }
+        let (_, lit) = rendered(fits, &at(j), &model.own, kind)?;
+        ev.iter_mut().zip(lit).for_each(|(e, lit)| e.lit = lit);
         solves.push(texels::solve(&ev, layouts, response, kind));
     }
     let cost = texels::value_cost(totals.0, totals.1);
@@ -115,7 +125,10 @@ fn choose(solves: &[Vec<ObjectMap>], cost: f64, bare: &Scene) -> Vec<(ObjectMap,
         let o = base.object;
         let scalar = bare.objects[o].material.shininess;
         let texels = base.cell_sad.len();
-        let of = |j: usize| solves[j].iter().find(|m| m.object == o);
+        let maps: Vec<Option<&ObjectMap>> = solves
+            .iter()
+            .map(|s| s.iter().find(|m| m.object == o))
+            .collect();
         let mut strength = vec![1.0_f32; 3 * texels];
         let mut shine = vec![scalar as f32; 3 * texels];
         let (mut strength_count, mut shine_count) = (0, 0);
@@ -123,7 +136,7 @@ fn choose(solves: &[Vec<ObjectMap>], cost: f64, bare: &Scene) -> Vec<(ObjectMap,
             // (score, step, strength) of the best step so far.
             let mut best: Option<(f64, usize, f32)> = None;
             for j in order(solves.len()) {
-                let Some(map) = of(j) else { continue };
+                let Some(map) = maps[j] else { continue };
                 let value = map.values[3 * t];
                 let held = usize::from(value != 1.0) + usize::from(j != centre);
                 let score = map.cell_sad[t] + cost * held as f64;

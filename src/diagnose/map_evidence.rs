@@ -43,22 +43,11 @@ pub(super) fn evidence<'a>(
         .map(|o| (o, zero.clone()))
         .collect();
     let dark_scene = with_maps(scene, &probe, kind);
-    let rendered = |fits: &mut Refits, s: &Scene| -> Result<(Vec<Shot>, Vec<Image>)> {
-        let shots: Vec<Shot> = shots_of(s, inputs, own)?;
-        let images = fits.render(&shots)?.map(|(images, _)| images);
-        let images = images.ok_or_else(|| {
-            Error::Run(format!(
-                "{}: a render of the photographs failed",
-                kind.key()
-            ))
-        })?;
-        Ok((shots, images))
-    };
     let (shots, lit) = match held {
         Some(images) => (shots_of(scene, inputs, own)?, images.to_vec()),
-        None => rendered(fits, scene)?,
+        None => rendered(fits, scene, own, kind)?,
     };
-    let dark = rendered(fits, &dark_scene);
+    let dark = rendered(fits, &dark_scene, own, kind);
     super::map_file::discard(&zero_path);
     let (_, dark) = dark?;
     Ok(inputs
@@ -73,6 +62,26 @@ pub(super) fn evidence<'a>(
             coords: surface_coords(&shot.scene),
         })
         .collect())
+}
+
+/// Each photograph's shot of `scene` with its `own` values, and its
+/// render: the lit half of `evidence`, alone for a caller that varies
+/// only what the dark render does not see (`gloss.rs`'s exponent).
+pub(super) fn rendered(
+    fits: &mut Refits,
+    scene: &Scene,
+    own: &[Params],
+    kind: MapKind,
+) -> Result<(Vec<Shot>, Vec<Image>)> {
+    let shots: Vec<Shot> = shots_of(scene, fits.inputs, own)?;
+    let images = fits.render(&shots)?.map(|(images, _)| images);
+    let images = images.ok_or_else(|| {
+        Error::Run(format!(
+            "{}: a render of the photographs failed",
+            kind.key()
+        ))
+    })?;
+    Ok((shots, images))
 }
 
 /// `scene` with the maps of `kind` that `with` added to `without` removed.

@@ -233,6 +233,13 @@ pub fn write_truth(dir: &Path, surface: Surface, kind: Truth) -> Vec<f64> {
     floors
 }
 
+/// A map the diagnosis wrote, read linear as the tracer reads it, and
+/// the value its brightest texel stands for (`range`'s top).
+fn read_map(t: &texture::TextureRef) -> (std::sync::Arc<texture::Texels>, f64) {
+    let texels = texture::get(Path::new(t.file()), Encoding::Linear).unwrap();
+    (texels, t.range()[1])
+}
+
 /// The colour error of the colour map in `improved` (a loaded scene):
 /// per texel, the map's value times the scalar colour against the mean
 /// true colour of the surface points the photographs fitted (all but the
@@ -241,10 +248,10 @@ pub fn write_truth(dir: &Path, surface: Surface, kind: Truth) -> Vec<f64> {
 /// Without a colour map, every texel holds the scalar colour.
 pub fn colour_error(improved: &Scene, surface: Surface) -> (f64, usize) {
     let m = &improved.objects[0].material;
-    let map = m.color_map.as_ref().map(|t| {
-        let texels = texture::get(Path::new(t.file()), Encoding::Linear).unwrap();
-        (texels, t.scale(), t.range()[1])
-    });
+    let map = m
+        .color_map
+        .as_ref()
+        .map(|t| (read_map(t).0, t.scale(), t.range()[1]));
     let side = map.as_ref().map_or(1, |(t, _, _)| t.width as usize);
     let rows = map.as_ref().map_or(1, |(t, _, _)| t.height as usize);
     let scale = map.as_ref().map_or([1.0, 1.0], |(_, s, _)| *s);
@@ -294,13 +301,8 @@ pub fn colour_error(improved: &Scene, surface: Surface) -> (f64, usize) {
 /// off 1), in the broad region and in the rest.
 pub fn shininess_by_region(improved: &Scene, surface: Surface) -> [f64; 2] {
     let m = &improved.objects[0].material;
-    let read = |t: &texture::TextureRef| {
-        let texels = texture::get(Path::new(t.file()), Encoding::Linear).unwrap();
-        let hi = t.range()[1];
-        (texels, hi)
-    };
-    let (shine, hi) = read(m.shininess_map.as_ref().expect("a shininess map"));
-    let strength = m.specular_map.as_ref().map(read);
+    let (shine, hi) = read_map(m.shininess_map.as_ref().expect("a shininess map"));
+    let strength = m.specular_map.as_ref().map(read_map);
     let (w, h) = (shine.width as usize, shine.height as usize);
     let mut regions = [Vec::new(), Vec::new()];
     for y in 0..h {
