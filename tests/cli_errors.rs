@@ -354,6 +354,20 @@ fn negative_numbers_name_their_option() {
     assert!(!d.path().join("out").exists() && !d.path().join("x.png").exists());
 }
 
+/// `diagnose --effects` with a name no effect has: one line naming the
+/// option, the name and the names there are, before anything is read or
+/// written.
+#[test]
+fn an_unknown_effect_name_is_refused_naming_the_known_ones() {
+    let d = tempfile::tempdir().unwrap();
+    let args = ["diagnose", "fitdir", "-o", "out", "--effects"];
+    for (names, bad) in [("albedo_map,shine", "\"shine\""), ("", "\"\"")] {
+        let out = scenefit(d.path(), &[&args[..], &[names]].concat());
+        assert_user_error(&out, &["--effects", bad, "albedo_map", "camera_response"]);
+    }
+    assert!(!d.path().join("out").exists());
+}
+
 #[test]
 fn a_huge_worker_count_is_refused_by_its_option() {
     let d = tempfile::tempdir().unwrap();

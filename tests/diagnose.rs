@@ -1,7 +1,8 @@
 //! `scenefit diagnose` on generated data (tests/effects_data): the first
 //! accepted effect is the planted one for all but one of the effects, the
 //! deviation falls to at most half for every one, noise-only targets
-//! accept nothing, and the diagnosis does not depend on `--jobs`.
+//! accept nothing, the diagnosis does not depend on `--jobs`, and
+//! `--effects` limits the effects tried.
 
 mod effects_data;
 
@@ -9,7 +10,7 @@ use effects_data::{case, effects, fit_case};
 use scenefit::diagnose::{self, DiagnoseConfig, Inputs, SetInputs};
 
 fn diagnose_case(effect: &str, variant: u32, seed: u64, noise: f64) -> diagnose::Diagnosis {
-    diagnose_case_with(effect, variant, seed, noise, DiagnoseConfig::default().jobs)
+    diagnose_case_with(effect, variant, seed, noise, |_| {})
 }
 
 fn diagnose_case_with(
@@ -17,7 +18,7 @@ fn diagnose_case_with(
     variant: u32,
     seed: u64,
     noise: f64,
-    jobs: usize,
+    adjust: impl Fn(&mut DiagnoseConfig),
 ) -> diagnose::Diagnosis {
     let c = case(effect, variant, 1.0, seed, noise);
     let tmp = tempfile::tempdir().unwrap();
@@ -30,12 +31,12 @@ fn diagnose_case_with(
     std::fs::create_dir_all(&fit_dir).unwrap();
     fit_case(&c, &fit_dir, seed);
     let inputs = SetInputs::one(&Inputs::from_fit_dir(&fit_dir, None, None).unwrap());
-    let config = DiagnoseConfig {
+    let mut config = DiagnoseConfig {
         max_rounds: 1,
         seed,
-        jobs,
         ..DiagnoseConfig::default()
     };
+    adjust(&mut config);
     diagnose::run(&inputs, &dir.join("diag"), &config)
         .unwrap()
         .diagnosis
@@ -121,7 +122,7 @@ fn the_diagnosis_is_the_same_whatever_the_jobs() {
     let runs: Vec<String> = [1, 3]
         .iter()
         .map(|&jobs| {
-            let d = diagnose_case_with("vignetting", 0, 5, 0.0, jobs);
+            let d = diagnose_case_with("vignetting", 0, 5, 0.0, |c| c.jobs = jobs);
             let mut v = serde_json::to_value(&d).unwrap();
             v.as_object_mut().unwrap().remove("wall_seconds");
             v.to_string()
@@ -129,4 +130,35 @@ fn the_diagnosis_is_the_same_whatever_the_jobs() {
         .collect();
     assert!(runs[0].contains("vignetting"), "{}", runs[0]);
     assert_eq!(runs[0], runs[1]);
+}
+
+/// `--effects` (`DiagnoseConfig::effects`): only the effects named are
+/// tried, so a planted effect left out is neither a candidate nor
+/// accepted, and one named is found as without the restriction.
+#[test]
+fn only_the_effects_named_are_tried() {
+    let tried = |d: &diagnose::Diagnosis| -> Vec<String> {
+        d.candidates.iter().map(|c| c.effect.clone()).collect()
+    };
+    let named = ["light_color", "vignetting"].map(String::from).to_vec();
+    let with = diagnose_case_with("vignetting", 0, 5, 0.0, |c| c.effects = Some(named.clone()));
+    assert!(!tried(&with).is_empty());
+    assert!(
+        tried(&with).iter().all(|e| named.contains(e)),
+        "{:?}",
+        tried(&with)
+    );
+    assert_eq!(
+        with.accepted.first().map(String::as_str),
+        Some("vignetting")
+    );
+    let without = diagnose_case_with("vignetting", 0, 5, 0.0, |c| {
+        c.effects = Some(vec!["light_color".into()])
+    });
+    assert!(
+        tried(&without).iter().all(|e| e == "light_color"),
+        "{:?}",
+        tried(&without)
+    );
+    assert!(!without.accepted.iter().any(|a| a == "vignetting"));
 }

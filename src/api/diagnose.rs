@@ -31,6 +31,7 @@ pub struct DiagnoseRequest {
 /// Diagnoses the fit in `r.fit_dir` (one photograph or a set) into
 /// `r.output`; returned as its pooled part.
 pub fn diagnose(r: &DiagnoseRequest) -> Result<Diagnosis> {
+    check_effects(&r.config)?;
     let set = SetInputs::from_fit_dir(&r.fit_dir, &r.hold_out)?;
     if set.is_none() && !r.hold_out.is_empty() {
         return Err(Error::Usage(
@@ -61,6 +62,25 @@ pub fn diagnose(r: &DiagnoseRequest) -> Result<Diagnosis> {
         out.clear()?;
     }
     Ok(diagnose::run(&inputs, &r.output, &r.config)?.diagnosis)
+}
+
+/// Every effect `config` names is one the registry holds, and it names
+/// at least one.
+fn check_effects(config: &DiagnoseConfig) -> Result<()> {
+    let Some(names) = &config.effects else {
+        return Ok(());
+    };
+    let known = diagnose::effects::names();
+    match names.iter().find(|e| !known.contains(&e.as_str())) {
+        Some(bad) => Err(Error::Usage(format!(
+            "--effects: no effect named {bad:?}; expected one or more of {}",
+            known.join(", ")
+        ))),
+        None if names.is_empty() => Err(Error::Usage(
+            "--effects: expected one or more effect names".into(),
+        )),
+        None => Ok(()),
+    }
 }
 
 /// The output directory, locked, by the run-directory rule; never the fit

@@ -40,6 +40,11 @@ pub struct DiagnoseArgs {
     /// Effects accepted at most.
     #[arg(long, default_value_t = 3, value_parser = super::numbers::whole, allow_hyphen_values = true)]
     max_effects: usize,
+    /// Try only these effects (names as in docs/diagnose.md's table), e.g.
+    /// `albedo_map` alone for a per-texel Lambertian baseline; default:
+    /// every effect.
+    #[arg(long, value_delimiter = ',', value_name = "NAME,...")]
+    effects: Vec<String>,
     #[arg(long, default_value_t = 1, value_parser = super::numbers::seed, allow_hyphen_values = true)]
     seed: u64,
     /// Refit the shared free parameters that move geometry (object shapes,
@@ -98,6 +103,7 @@ pub fn run(a: DiagnoseArgs) -> Result<()> {
         seed: a.seed,
         refit_geometry: a.refit_geometry,
         map_size: a.map_size,
+        effects: (!a.effects.is_empty()).then_some(a.effects),
         ..DiagnoseConfig::default()
     };
     if let Some(j) = a.jobs {

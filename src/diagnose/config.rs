@@ -32,6 +32,10 @@ pub struct DiagnoseConfig {
     pub restart_population: usize,
     /// Effects accepted at most.
     pub max_rounds: usize,
+    /// The effects tried, by name (None: every effect in the registry);
+    /// a user's own baseline, e.g. a per-texel Lambertian model as
+    /// `albedo_map` alone on a matte fit.
+    pub effects: Option<Vec<String>>,
     /// Least relative drop of the residual sum of squares to accept.
     pub min_gain: f64,
     /// BIC must drop by more than this.
@@ -62,6 +66,7 @@ impl Default for DiagnoseConfig {
             restart_generations: 250,
             restart_population: 40,
             max_rounds: 3,
+            effects: None,
             min_gain: 0.05,
             bic_margin: 10.0,
             seed: 1,

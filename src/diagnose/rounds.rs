@@ -19,6 +19,7 @@ use super::schedule::Refit;
 use super::selection::{choose, overdispersion_of, weigh};
 use super::trials::Trial;
 use super::Candidate;
+use super::DiagnoseConfig;
 use crate::error::Result;
 
 /// What the rounds found: the candidates of every round, the effects
@@ -61,9 +62,14 @@ pub(super) fn rounds(fits: &mut Refits, model: &mut Model, n: f64) -> Result<Rou
 }
 
 /// Whether `effect` is tried on these photographs: one that only a set
-/// can tell apart from the model is not tried on one photograph.
-fn tried_on(effect: &dyn Effect, inputs: &SetInputs) -> bool {
-    !(effect.set_only() && inputs.shots.len() < 2)
+/// can tell apart from the model is not tried on one photograph, nor one
+/// the user's `--effects` leaves out.
+fn tried_on(effect: &dyn Effect, inputs: &SetInputs, config: &DiagnoseConfig) -> bool {
+    let chosen = config
+        .effects
+        .as_ref()
+        .is_none_or(|names| names.iter().any(|n| n == effect.name()));
+    chosen && !(effect.set_only() && inputs.shots.len() < 2)
 }
 
 /// Pooled evidence: each photograph's R² weighted by its pixels.
@@ -90,7 +96,7 @@ fn round_of(
     let open: Vec<&'static dyn Effect> = effects::ALL
         .iter()
         .copied()
-        .filter(|e| tried_on(*e, inputs) && !accepted.iter().any(|a| a == e.name()))
+        .filter(|e| tried_on(*e, inputs, fits.config) && !accepted.iter().any(|a| a == e.name()))
         .collect();
     let best = try_effects(fits, model, &open, round)?;
     let mut tried: Vec<(Candidate, (Model, Step))> = Vec::new();
