@@ -13,10 +13,10 @@ pub const PHONG: &[MapKind] = ALL_MAPS;
 pub const BLENDER: &[MapKind] = ALL_MAPS;
 pub const MITSUBA: &[MapKind] = ALL_MAPS;
 
-/// The maps POV-Ray draws: not the shininess map (below), nor the normal
-/// map (its `normal { bump_map }` is a height field, and
-/// `normal { image_map }`-style tangent-space vectors it has not).
-pub const POVRAY: &[MapKind] = &[MapKind::Color, MapKind::Specular];
+/// The maps POV-Ray draws: not the normal map (its `normal { bump_map }`
+/// is a height field, and `normal { image_map }`-style tangent-space
+/// vectors it has not).
+pub const POVRAY: &[MapKind] = &[MapKind::Color, MapKind::Specular, MapKind::Shininess];
 
 /// Every map refusal of the Blender worker (`mitsuba` false) or the
 /// Mitsuba worker: the maps it does not draw, and what it does not draw
@@ -32,12 +32,12 @@ pub fn worker_refusals(scene: &Scene, mitsuba: bool) -> Vec<Refusal> {
     out
 }
 
-/// Every map refusal of POV-Ray: the maps it does not draw (the
-/// shininess map: its `roughness` is one number per texture, and a blend
-/// of two textures' highlights is not the lobe of the blended exponent),
-/// and what it does not draw them on: a box (no per-face coordinates),
-/// glass, and a specular map beside `specular2` (the specular map is a
-/// patterned texture, and POV-Ray layers nothing over one).
+/// Every map refusal of POV-Ray: the maps it does not draw, and what it
+/// does not draw them on: a box (no per-face coordinates), glass, a
+/// specular or shininess map beside `specular2` (each is a patterned
+/// texture, and POV-Ray layers nothing over one), and the three of
+/// colour, specular and shininess on a planar map (the colour pattern,
+/// nested two patterned textures deep, lands elsewhere: measured).
 pub fn povray_refusals(scene: &Scene) -> Vec<Refusal> {
     let mut out = refusals(scene, "povray", POVRAY);
     out.extend(limits(scene, true).into_iter().map(|mut r| {
@@ -46,10 +46,22 @@ pub fn povray_refusals(scene: &Scene) -> Vec<Refusal> {
     }));
     for o in &scene.objects {
         let m = &o.material;
-        if m.specular_map.is_some() && m.specular2.is_some_and(|k| k > 0.0) {
+        let planar = matches!(
+            o.shape,
+            crate::scene::Shape::Plane { .. } | crate::scene::Shape::Quad { .. }
+        );
+        if planar && m.color_map.is_some() && m.specular_map.is_some() && m.shininess_map.is_some()
+        {
+            out.push(Refusal::new(
+                format!("objects.{}.material.shininess_map", o.name),
+                "a shininess_map beside both a color_map and a specular_map on a plane or quad is not drawn by povray (the colour pattern, nested two textures deep, is not placed where the others are); use phong, blender or mitsuba, or drop one map",
+            ));
+        }
+        let patterned = m.specular_map.is_some() || m.shininess_map.is_some();
+        if patterned && m.specular2.is_some_and(|k| k > 0.0) {
             out.push(Refusal::new(
                 format!("objects.{}.material.specular2", o.name),
-                "a second lobe beside a specular_map is not drawn by povray (it layers no texture over a patterned one); use phong, blender or mitsuba",
+                "a second lobe beside a specular_map or shininess_map is not drawn by povray (it layers no texture over a patterned one); use phong, blender or mitsuba",
             ));
         }
     }

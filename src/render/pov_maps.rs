@@ -12,11 +12,34 @@ use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
 
 /// A map as written: the files of its channels (R, G, B for a colour
-/// map; R alone otherwise) and the factor they were divided by.
+/// map; R alone otherwise) and the factor they were divided by; for a
+/// shininess map, the exponents its `texture_map` holds (`levels`).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Channels {
     pub files: Vec<String>,
     pub scale: f64,
+    pub levels: Vec<f64>,
+}
+
+/// Most entries of a shininess map's `texture_map` (POV-Ray takes 256).
+pub const MAX_LEVELS: usize = 64;
+
+/// The exponents a shininess map's texture blends between: each value
+/// the map holds when there are at most `MAX_LEVELS` (a texel at one is
+/// drawn with exactly that lobe: the diagnosis writes a few grid values),
+/// else `MAX_LEVELS` spaced evenly in the logarithm from the least to the
+/// largest (a lobe's width goes as the exponent's logarithm).
+pub fn levels(values: &[f64]) -> Vec<f64> {
+    let mut v: Vec<f64> = values.iter().map(|&x| x.max(1e-6)).collect();
+    v.sort_by(f64::total_cmp);
+    v.dedup();
+    if v.len() <= MAX_LEVELS {
+        return v;
+    }
+    let (lo, hi) = (v[0].ln(), v[v.len() - 1].ln());
+    (0..MAX_LEVELS)
+        .map(|k| (lo + (hi - lo) * k as f64 / (MAX_LEVELS - 1) as f64).exp())
+        .collect()
 }
 
 /// (file, encoding, range bits, channels): what decides a written map.
@@ -79,8 +102,38 @@ impl PovMaps {
                 .map_err(|e| format!("{}: writing {name} for POV-Ray: {e}", kind.key()))?;
             files.push(name);
         }
-        let c = Arc::new(Channels { files, scale });
+        let levels = match kind {
+            MapKind::Shininess => levels(&values.iter().step_by(3).copied().collect::<Vec<_>>()),
+            _ => Vec::new(),
+        };
+        let c = Arc::new(Channels {
+            files,
+            scale,
+            levels,
+        });
         written.insert(key, c.clone());
         Ok(c)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_few_exponents_are_each_a_level() {
+        assert_eq!(levels(&[40.0, 10.0, 40.0, 20.0]), vec![10.0, 20.0, 40.0]);
+    }
+
+    /// More exponents than entries: `MAX_LEVELS` from the least to the
+    /// largest, evenly in the logarithm.
+    #[test]
+    fn many_exponents_are_spread_over_their_range() {
+        let values: Vec<f64> = (1..=500).map(f64::from).collect();
+        let l = levels(&values);
+        assert_eq!(l.len(), MAX_LEVELS);
+        assert!((l[0] - 1.0).abs() < 1e-9 && (l[MAX_LEVELS - 1] - 500.0).abs() < 1e-9);
+        let ratio = l[1] / l[0];
+        assert!(l.windows(2).all(|w| (w[1] / w[0] - ratio).abs() < 1e-9));
     }
 }

@@ -48,8 +48,9 @@
 //!   them) as bilinear `image_pattern`s placed by `mapping`; the colour
 //!   map as a pigment averaging three channel patterns, the specular map
 //!   as a patterned texture blending the texture without and with its
-//!   highlight. Refused (`maps::povray_refusals`): the shininess map, a
-//!   map on a box or on glass, a specular map beside `specular2`.
+//!   highlight, the shininess map as a patterned texture with an entry
+//!   per exponent. Refused (`maps::povray_refusals`): a map on a box or
+//!   on glass, a specular or shininess map beside `specular2`.
 
 use super::backend::Refusal;
 use super::pov_maps::Channels;
@@ -508,68 +509,111 @@ fn second_lobe(m: &Material, t: f64) -> String {
 }
 
 /// The texture of a material with maps (opaque; see the module doc): the
-/// pigment c x the colour map as the average of three channel patterns,
-/// channel k `color_map`ped from 0 to 3 c_k s (s the factor the files
-/// were divided by: `pov_maps`); a specular map as a patterned texture
+/// pigment `mapped_pigment`; a specular map as a patterned texture
 /// blending that texture without and with its highlight, which is linear
-/// in ks, so the blend is ks x the map.
+/// in ks, so the blend is ks x the map; a shininess map as a patterned
+/// texture with one entry per exponent it holds (`pov_maps::levels`),
+/// each that texture with its highlight at that exponent.
 fn mapped_material(o: &Object, maps: MapSource) -> Result<String, String> {
     let m = &o.material;
-    let get = |k: MapKind, t: &TextureRef| -> Result<(Arc<Channels>, String, String), String> {
-        let ch = maps(t, k).map_err(|e| format!("objects.{}.material.{e}", o.name))?;
-        let (pre, post) = mapping(&o.shape, t.scale()).ok_or_else(|| {
-            format!(
-                "objects.{}.material.{}: not drawn on this shape by POV-Ray",
-                o.name,
-                k.key()
-            )
-        })?;
-        Ok((ch, pre, post))
-    };
-    let pigment = match &m.color_map {
-        Some(t) => {
-            let (ch, pre, mut post) = get(MapKind::Color, t)?;
-            // inside a specular map's patterned texture a planar pattern
-            // is carried by that texture's transform too (measured): only
-            // the ratio of the two scales is left to apply
-            let planar = pre.is_empty();
-            if let (true, Some(s)) = (planar, &m.specular_map) {
-                let (a, b) = (s.scale(), t.scale());
-                post = format!(" scale <{}, {}, 1>", num(a[0] / b[0]), num(a[1] / b[1]));
-            }
-            let entries: String = (0..3)
-                .map(|k| {
-                    let mut c = [0.0; 3];
-                    c[k] = 3.0 * m.color[k] * ch.scale;
-                    format!(
-                        " [1 {pre}{} color_map {{ [0 rgb 0] [1 {}] }}{post}]",
-                        pattern(&ch.files[k]),
-                        rgb(c, 1.0)
-                    )
-                })
-                .collect();
-            format!("average pigment_map {{{entries} }}")
-        }
-        None => rgb(m.color, 1.0),
-    };
-    let base = |ks: f64| {
+    let get = |k: MapKind, t: &TextureRef, outer: Option<&TextureRef>| placed(o, maps, k, t, outer);
+    let pigment = mapped_pigment(o, maps)?;
+    let base = |mat: &Material, ks: f64| {
         format!(
             "pigment {{ {pigment} }} finish {{ {} }}",
-            finish(m, 1.0, ks)
+            finish(mat, 1.0, ks)
         )
     };
+    // The texture with its highlight (ks x `ks`): at the material's
+    // exponent, or per texel at the shininess map's.
+    let lit = |ks: f64| -> Result<String, String> {
+        let Some(t) = &m.shininess_map else {
+            return Ok(base(m, ks));
+        };
+        let (ch, pre, post) = get(MapKind::Shininess, t, m.specular_map.as_ref())?;
+        let at = |n: f64| {
+            let mut mat = m.clone();
+            mat.shininess = n;
+            base(&mat, ks)
+        };
+        if let [n] = ch.levels[..] {
+            return Ok(at(n));
+        }
+        let entries: String = ch
+            .levels
+            .iter()
+            .map(|&n| format!(" [{} {}]", num(n / ch.scale), at(n)))
+            .collect();
+        Ok(format!(
+            "{pre}{}{post} texture_map {{{entries} }}",
+            pattern(&ch.files[0])
+        ))
+    };
     Ok(match &m.specular_map {
-        None => format!("texture {{ {} }}{}", base(1.0), second_lobe(m, 0.0)),
+        None => format!("texture {{ {} }}{}", lit(1.0)?, second_lobe(m, 0.0)),
         Some(t) => {
-            let (ch, pre, post) = get(MapKind::Specular, t)?;
+            let (ch, pre, post) = get(MapKind::Specular, t, None)?;
             format!(
                 "texture {{ {pre}{}{post} texture_map {{ [0 {}] [1 {}] }} }}",
                 pattern(&ch.files[0]),
-                base(0.0),
-                base(ch.scale)
+                base(m, 0.0),
+                lit(ch.scale)?
             )
         }
     })
+}
+
+/// Map `t` of kind `k` as POV-Ray reads it: its files, and what goes
+/// before and after its pattern. A pattern nested in a patterned texture
+/// (`outer`'s): on a planar map it is carried by the enclosing pattern's
+/// transform too (measured), so only the ratio of the two scales is left
+/// to apply.
+fn placed(
+    o: &Object,
+    maps: MapSource,
+    k: MapKind,
+    t: &TextureRef,
+    outer: Option<&TextureRef>,
+) -> Result<(Arc<Channels>, String, String), String> {
+    let ch = maps(t, k).map_err(|e| format!("objects.{}.material.{e}", o.name))?;
+    let (pre, mut post) = mapping(&o.shape, t.scale()).ok_or_else(|| {
+        format!(
+            "objects.{}.material.{}: not drawn on this shape by POV-Ray",
+            o.name,
+            k.key()
+        )
+    })?;
+    if let (true, Some(outer)) = (pre.is_empty(), outer) {
+        let (a, b) = (outer.scale(), t.scale());
+        post = format!(" scale <{}, {}, 1>", num(a[0] / b[0]), num(a[1] / b[1]));
+    }
+    Ok((ch, pre, post))
+}
+
+/// The pigment of a material with maps: c x the colour map as the
+/// average of three channel patterns, channel k `color_map`ped from 0 to
+/// 3 c_k s (s the factor the files were divided by: `pov_maps`), nested
+/// in the innermost patterned texture (a colour map beside both of the
+/// others on a planar map is refused: `maps::povray_refusals`).
+fn mapped_pigment(o: &Object, maps: MapSource) -> Result<String, String> {
+    let m = &o.material;
+    let Some(t) = &m.color_map else {
+        return Ok(rgb(m.color, 1.0));
+    };
+    let innermost = m.shininess_map.as_ref().or(m.specular_map.as_ref());
+    let (ch, pre, post) = placed(o, maps, MapKind::Color, t, innermost)?;
+    let entries: String = (0..3)
+        .map(|k| {
+            let mut c = [0.0; 3];
+            c[k] = 3.0 * m.color[k] * ch.scale;
+            format!(
+                " [1 {pre}{} color_map {{ [0 rgb 0] [1 {}] }}{post}]",
+                pattern(&ch.files[k]),
+                rgb(c, 1.0)
+            )
+        })
+        .collect();
+    Ok(format!("average pigment_map {{{entries} }}"))
 }
 
 /// A written map file as a bilinear, linear pattern (`pov_maps`).
