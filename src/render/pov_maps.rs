@@ -42,8 +42,10 @@ pub fn levels(values: &[f64]) -> Vec<f64> {
         .collect()
 }
 
-/// (file, encoding, range bits, channels): what decides a written map.
-type Key = (String, Encoding, [u64; 2], usize);
+/// (file, encoding, range bits, channels, whether its `levels` are
+/// wanted): what decides a written map. The same file may be a specular
+/// map and a shininess map of one scene.
+type Key = (String, Encoding, [u64; 2], usize, bool);
 
 /// The maps written into one run directory.
 pub struct PovMaps {
@@ -65,11 +67,13 @@ impl PovMaps {
         let channels = if kind == MapKind::Color { 3 } else { 1 };
         let [lo, hi] = t.range();
         let enc = t.encoding(kind);
+        let shininess = kind == MapKind::Shininess;
         let key = (
             t.file().to_string(),
             enc,
             [lo.to_bits(), hi.to_bits()],
             channels,
+            shininess,
         );
         let mut written = self.written.lock().expect("pov maps");
         if let Some(c) = written.get(&key) {
@@ -102,9 +106,10 @@ impl PovMaps {
                 .map_err(|e| format!("{}: writing {name} for POV-Ray: {e}", kind.key()))?;
             files.push(name);
         }
-        let levels = match kind {
-            MapKind::Shininess => levels(&values.iter().step_by(3).copied().collect::<Vec<_>>()),
-            _ => Vec::new(),
+        let levels = if shininess {
+            levels(&values.iter().step_by(3).copied().collect::<Vec<_>>())
+        } else {
+            Vec::new()
         };
         let c = Arc::new(Channels {
             files,
@@ -119,6 +124,22 @@ impl PovMaps {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// One file as a specular map and then as a shininess map (same
+    /// range): the second gets its own levels, not the first's none.
+    #[test]
+    fn a_file_read_as_both_maps_has_levels_as_a_shininess_map() {
+        let dir = tempfile::tempdir().unwrap();
+        let file = dir.path().join("g.png");
+        image::GrayImage::from_fn(2, 1, |x, _| image::Luma([if x == 0 { 51 } else { 204 }]))
+            .save(&file)
+            .unwrap();
+        let t = TextureRef::File(file.to_string_lossy().into_owned());
+        let maps = PovMaps::new(dir.path());
+        assert!(maps.get(&t, MapKind::Specular).unwrap().levels.is_empty());
+        let l = &maps.get(&t, MapKind::Shininess).unwrap().levels;
+        assert_eq!(l.len(), 2, "{l:?}");
+    }
 
     #[test]
     fn a_few_exponents_are_each_a_level() {
