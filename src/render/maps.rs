@@ -35,9 +35,7 @@ pub fn worker_refusals(scene: &Scene, mitsuba: bool) -> Vec<Refusal> {
 /// Every map refusal of POV-Ray: the maps it does not draw, and what it
 /// does not draw them on: a box (no per-face coordinates), glass, a
 /// specular or shininess map beside `specular2` (each is a patterned
-/// texture, and POV-Ray layers nothing over one), and the three of
-/// colour, specular and shininess on a planar map (the colour pattern,
-/// nested two patterned textures deep, lands elsewhere: measured).
+/// texture, and POV-Ray layers nothing over one).
 pub fn povray_refusals(scene: &Scene) -> Vec<Refusal> {
     let mut out = refusals(scene, "povray", POVRAY);
     out.extend(limits(scene, true).into_iter().map(|mut r| {
@@ -46,17 +44,6 @@ pub fn povray_refusals(scene: &Scene) -> Vec<Refusal> {
     }));
     for o in &scene.objects {
         let m = &o.material;
-        let planar = matches!(
-            o.shape,
-            crate::scene::Shape::Plane { .. } | crate::scene::Shape::Quad { .. }
-        );
-        if planar && m.color_map.is_some() && m.specular_map.is_some() && m.shininess_map.is_some()
-        {
-            out.push(Refusal::new(
-                format!("objects.{}.material.shininess_map", o.name),
-                "a shininess_map beside both a color_map and a specular_map on a plane or quad is not drawn by povray (the colour pattern, nested two textures deep, is not placed where the others are); use phong, blender or mitsuba, or drop one map",
-            ));
-        }
         let patterned = m.specular_map.is_some() || m.shininess_map.is_some();
         if patterned && m.specular2.is_some_and(|k| k > 0.0) {
             out.push(Refusal::new(

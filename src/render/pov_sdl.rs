@@ -517,13 +517,21 @@ fn second_lobe(m: &Material, t: f64) -> String {
 fn mapped_material(o: &Object, maps: MapSource) -> Result<String, String> {
     let m = &o.material;
     let get = |k: MapKind, t: &TextureRef, outer: Option<&TextureRef>| placed(o, maps, k, t, outer);
-    let pigment = mapped_pigment(o, maps)?;
-    let base = |mat: &Material, ks: f64| {
+    // On a planar map a nested pattern is carried by every enclosing
+    // pattern's transform, so the pigment is placed for the texture it
+    // sits in: the specular map's entries, or the shininess map's.
+    let in_specular = mapped_pigment(o, maps, m.specular_map.as_ref())?;
+    let in_shininess = match &m.shininess_map {
+        Some(t) => mapped_pigment(o, maps, Some(t))?,
+        None => in_specular.clone(),
+    };
+    let with = |pigment: &str, mat: &Material, ks: f64| {
         format!(
             "pigment {{ {pigment} }} finish {{ {} }}",
             finish(mat, 1.0, ks)
         )
     };
+    let base = |mat: &Material, ks: f64| with(&in_specular, mat, ks);
     // The texture with its highlight (ks x `ks`): at the material's
     // exponent, or per texel at the shininess map's.
     let lit = |ks: f64| -> Result<String, String> {
@@ -534,10 +542,13 @@ fn mapped_material(o: &Object, maps: MapSource) -> Result<String, String> {
         let at = |n: f64| {
             let mut mat = m.clone();
             mat.shininess = n;
-            base(&mat, ks)
+            with(&in_shininess, &mat, ks)
         };
         if let [n] = ch.levels[..] {
-            return Ok(at(n));
+            // One exponent: no pattern, so the pigment sits where `base` is.
+            let mut mat = m.clone();
+            mat.shininess = n;
+            return Ok(base(&mat, ks));
         }
         let entries: String = ch
             .levels
@@ -592,16 +603,18 @@ fn placed(
 
 /// The pigment of a material with maps: c x the colour map as the
 /// average of three channel patterns, channel k `color_map`ped from 0 to
-/// 3 c_k s (s the factor the files were divided by: `pov_maps`), nested
-/// in the innermost patterned texture (a colour map beside both of the
-/// others on a planar map is refused: `maps::povray_refusals`).
-fn mapped_pigment(o: &Object, maps: MapSource) -> Result<String, String> {
+/// 3 c_k s (s the factor the files were divided by: `pov_maps`), placed
+/// for the patterned texture it is nested in (`outer`'s map, None: none).
+fn mapped_pigment(
+    o: &Object,
+    maps: MapSource,
+    outer: Option<&TextureRef>,
+) -> Result<String, String> {
     let m = &o.material;
     let Some(t) = &m.color_map else {
         return Ok(rgb(m.color, 1.0));
     };
-    let innermost = m.shininess_map.as_ref().or(m.specular_map.as_ref());
-    let (ch, pre, post) = placed(o, maps, MapKind::Color, t, innermost)?;
+    let (ch, pre, post) = placed(o, maps, MapKind::Color, t, outer)?;
     let entries: String = (0..3)
         .map(|k| {
             let mut c = [0.0; 3];

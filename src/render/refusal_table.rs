@@ -5,7 +5,6 @@
 
 use super::registry::ALL;
 use crate::scene::test_scene::ball;
-use crate::scene::texture::MapKind;
 use crate::scene::{Falloff, LightKind, Scene, TextureRef};
 use std::collections::BTreeSet;
 
@@ -49,15 +48,6 @@ fn scene_for(field: &str) -> Scene {
         "`render.max_depth` above 254" => s.render.max_depth = 255,
         "`material.diffuse_f90` (other than 1)" => m.diffuse_f90 = Some(0.5),
         "`material.albedo_map`" => m.albedo_map = Some("map.png".into()),
-        "a `shininess_map` beside a `color_map` and a `specular_map` on a `plane` or `quad`" => {
-            for kind in [MapKind::Color, MapKind::Specular, MapKind::Shininess] {
-                *m.map_slot(kind) = Some(TextureRef::File("t.png".into()));
-            }
-            s.objects[0].shape = serde_json::from_value(
-                serde_json::json!({"type": "quad", "corner": [0.0, 0.0, 0.0], "edge_u": [1.0, 0.0, 0.0], "edge_v": [0.0, 1.0, 0.0]}),
-            )
-            .unwrap();
-        }
         "a `specular_map` or `shininess_map` with `specular2` > 0" => {
             m.specular_map = Some(TextureRef::File("t.png".into()));
             m.specular2 = Some(0.2);
