@@ -492,6 +492,77 @@ fn povray_draws_the_three_maps_together_on_a_quad_and_a_plane() {
     }
 }
 
+/// POV-Ray draws a normal map on a plane or quad (the height field of
+/// its slopes, `render/pov_bumps.rs`) as the built-in tracer does: on a
+/// quad facing the camera, a turned quad holding the colour, specular
+/// and shininess maps too (the normal nested in their patterned
+/// textures), and a tilted plane; within 1 % over the image and within a
+/// quarter of what the normal map itself changes. A map stretched
+/// unevenly, whose normals no height has, is refused, not drawn wrong.
+#[test]
+fn povray_draws_a_normal_map_on_a_quad_and_a_plane_as_the_built_in_tracer_does() {
+    if !common::have("povray", "POV-Ray") {
+        return;
+    }
+    let d = tempfile::tempdir().unwrap();
+    let root = common::root().join("scenes/textured");
+    let (bumps, checker, stripes) = (
+        root.join("bumps.png"),
+        root.join("checker.png"),
+        root.join("stripes.png"),
+    );
+    let front = json!({"type": "quad", "corner": [-0.9, -0.9, 0], "edge_u": [1.8, 0, 0], "edge_v": [0, 1.8, 0]});
+    let turned = json!({"type": "quad", "corner": [-0.8, -0.8, 0.3], "edge_u": [1.5, 0, -0.6], "edge_v": [0, 1.6154, 0]});
+    let plane = json!({"type": "plane", "point": [0, -0.5, 0], "normal": [0, 1, 0.4]});
+    let normal = json!({"file": bumps, "scale": [2, 2]});
+    let plain = json!({"color": [0.6, 0.6, 0.6], "specular": 0.3, "shininess": 20});
+    let mut all = plain.clone();
+    all["color_map"] = json!({"file": checker, "scale": [1, 1.5]});
+    all["specular_map"] = json!({"file": stripes, "scale": [1, 2]});
+    all["shininess_map"] = json!({"file": stripes, "range": [5, 60], "scale": [3, 1]});
+    let scene = |shape: &Value, material: &Value| {
+        json!({"format": "scenefit-scene/1", "image": {"width": 128, "height": 128},
+            "camera": {"type": "perspective", "position": [0, 0, 3], "look_at": [0, 0, 0], "fov_y_deg": 40},
+            "render": {"samples": 64, "indirect": false, "antialias": 4},
+            "lights": [{"name": "key", "type": "point", "position": [0.8, 0.6, 2], "intensity": 6.0}],
+            "objects": [{"name": "tile", "shape": shape, "material": material}]})
+    };
+    let render = |s: &Value, backend: &str| {
+        let p = d.path().join("normal.json");
+        std::fs::write(&p, s.to_string()).unwrap();
+        let scene = api::load_scene(&p, &[]).unwrap();
+        let r = api::renderer(backend, &RenderOptions::default()).unwrap();
+        api::render(&scene, backend, r.as_ref(), 0)
+    };
+    for (name, shape, material) in [
+        ("front quad", &front, &plain),
+        ("turned quad, three maps besides", &turned, &all),
+        ("tilted plane", &plane, &plain),
+    ] {
+        let mut mapped = material.clone();
+        mapped["normal_map"] = normal.clone();
+        let phong = render(&scene(shape, &mapped), "phong").unwrap();
+        let pov = render(&scene(shape, &mapped), "povray").unwrap();
+        let flat = render(&scene(shape, material), "phong").unwrap();
+        let dev = scenefit::metric::deviation(&pov, &phong, None).average;
+        let effect = scenefit::metric::deviation(&flat, &phong, None).average;
+        eprintln!(
+            "{name}: POV-Ray {dev:.3} % from phong, the normal map's own effect {effect:.3} %"
+        );
+        assert!(
+            dev <= 1.0 && dev < 0.25 * effect,
+            "{name}: {dev:.3} % (the map moves {effect:.3} %)"
+        );
+    }
+    let mut stretched = plain.clone();
+    stretched["normal_map"] = json!({"file": bumps, "scale": [1, 3]});
+    let refused = match render(&scene(&front, &stretched), "povray") {
+        Ok(_) => panic!("a stretched normal map was drawn"),
+        Err(e) => e.to_string(),
+    };
+    assert!(refused.contains("height field"), "{refused}");
+}
+
 /// Mitsuba (`normalmap` BSDF) and Blender (Normal Map node) draw the
 /// normal map as the built-in tracer does, Blender on a turned box too:
 /// within 1 % over the image.

@@ -13,10 +13,9 @@ pub const PHONG: &[MapKind] = ALL_MAPS;
 pub const BLENDER: &[MapKind] = ALL_MAPS;
 pub const MITSUBA: &[MapKind] = ALL_MAPS;
 
-/// The maps POV-Ray draws: not the normal map (its `normal { bump_map }`
-/// is a height field, and `normal { image_map }`-style tangent-space
-/// vectors it has not).
-pub const POVRAY: &[MapKind] = &[MapKind::Color, MapKind::Specular, MapKind::Shininess];
+/// The maps POV-Ray draws: all four, the normal map on a plane or quad
+/// only (`povray_refusals`).
+pub const POVRAY: &[MapKind] = ALL_MAPS;
 
 /// Every map refusal of the Blender worker (`mitsuba` false) or the
 /// Mitsuba worker: the maps it does not draw, and what it does not draw
@@ -35,7 +34,8 @@ pub fn worker_refusals(scene: &Scene, mitsuba: bool) -> Vec<Refusal> {
 /// Every map refusal of POV-Ray: the maps it does not draw, and what it
 /// does not draw them on: a box (no per-face coordinates), glass, a
 /// specular or shininess map beside `specular2` (each is a patterned
-/// texture, and POV-Ray layers nothing over one).
+/// texture, and POV-Ray layers nothing over one), a normal map on other
+/// than a plane or quad.
 pub fn povray_refusals(scene: &Scene) -> Vec<Refusal> {
     let mut out = refusals(scene, "povray", POVRAY);
     out.extend(limits(scene, true).into_iter().map(|mut r| {
@@ -44,6 +44,28 @@ pub fn povray_refusals(scene: &Scene) -> Vec<Refusal> {
     }));
     for o in &scene.objects {
         let m = &o.material;
+        let planar = matches!(
+            o.shape,
+            crate::scene::Shape::Plane { .. } | crate::scene::Shape::Quad { .. }
+        );
+        if let Some(t) = m.normal_map.as_ref().filter(|_| planar) {
+            let frame = super::pov_bumps::planar_frame(&o.shape, t.scale());
+            // an unreadable file is the scene check's to report
+            let missed = frame.and_then(|f| super::pov_bumps::missed(t, f).ok());
+            if let Some(m) = missed.filter(|&m| m > super::pov_bumps::MAX_MISSED) {
+                let why = super::pov_bumps::not_a_height_field(m);
+                out.push(Refusal::new(
+                    format!("objects.{}.material.normal_map", o.name),
+                    why.trim_start_matches("normal_map: ").to_string(),
+                ));
+            }
+        }
+        if m.normal_map.is_some() && !planar {
+            out.push(Refusal::new(
+                format!("objects.{}.material.normal_map", o.name),
+                "a normal_map is drawn by povray on a plane or quad only (its normal is a height field's gradient, and on a sphere or mesh POV-Ray's uv_mapping tilts the normal along the world's axes, not the surface's); use phong, blender or mitsuba",
+            ));
+        }
         let patterned = m.specular_map.is_some() || m.shininess_map.is_some();
         if patterned && m.specular2.is_some_and(|k| k > 0.0) {
             out.push(Refusal::new(

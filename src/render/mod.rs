@@ -17,6 +17,7 @@ pub mod maps;
 pub mod mitsuba;
 pub mod near_lights;
 pub mod pbr_fields;
+pub mod pov_bumps;
 pub mod pov_maps;
 pub mod pov_sdl;
 pub mod povray;

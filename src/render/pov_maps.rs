@@ -6,7 +6,8 @@
 //! bilinear) reads scenefit's linear values to 1/65535. The SDL names
 //! only these files (`m0r.png`, ...), never a path from the scene.
 
-use crate::scene::texture::{self, Encoding, MapKind, TextureRef};
+use super::pov_bumps::{self, Frame};
+use crate::scene::texture::{self, Encoding, MapKind, Texels, TextureRef};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
@@ -43,9 +44,10 @@ pub fn levels(values: &[f64]) -> Vec<f64> {
 }
 
 /// (file, encoding, range bits, channels, whether its `levels` are
-/// wanted): what decides a written map. The same file may be a specular
-/// map and a shininess map of one scene.
-type Key = (String, Encoding, [u64; 2], usize, bool);
+/// wanted, a normal map's frame bits): what decides a written map. The
+/// same file may be a specular map and a shininess map of one scene, and
+/// a normal map's height depends on the surface it lies on.
+type Key = (String, Encoding, [u64; 2], usize, bool, [u64; 4]);
 
 /// The maps written into one run directory.
 pub struct PovMaps {
@@ -63,7 +65,15 @@ impl PovMaps {
 
     /// The files POV-Ray reads for map `t` of kind `kind`, written on
     /// first use in this session.
-    pub fn get(&self, t: &TextureRef, kind: MapKind) -> Result<Arc<Channels>, String> {
+    /// A normal map (`kind` Normal) is written as the height field of its
+    /// slopes on the planar map `frame` (`pov_bumps`), `scale` its range
+    /// in world length.
+    pub fn get(
+        &self,
+        t: &TextureRef,
+        kind: MapKind,
+        frame: Option<Frame>,
+    ) -> Result<Arc<Channels>, String> {
         let channels = if kind == MapKind::Color { 3 } else { 1 };
         let [lo, hi] = t.range();
         let enc = t.encoding(kind);
@@ -74,6 +84,7 @@ impl PovMaps {
             [lo.to_bits(), hi.to_bits()],
             channels,
             shininess,
+            frame.unwrap_or_default().map(f64::to_bits),
         );
         let mut written = self.written.lock().expect("pov maps");
         if let Some(c) = written.get(&key) {
@@ -81,6 +92,13 @@ impl PovMaps {
         }
         let texels = texture::get(Path::new(t.file()), enc)
             .map_err(|e| format!("{}: {}: {e}", kind.key(), t.file()))?;
+        if kind == MapKind::Normal {
+            let frame = frame.ok_or("normal_map: drawn by POV-Ray on a plane or quad only")?;
+            let name = format!("m{}h.png", written.len());
+            let c = Arc::new(self.write_heights(&texels, frame, &name)?);
+            written.insert(key, c.clone());
+            return Ok(c);
+        }
         let values: Vec<f64> = texels
             .values
             .iter()
@@ -119,6 +137,35 @@ impl PovMaps {
         written.insert(key, c.clone());
         Ok(c)
     }
+
+    /// The height field of the normal map `texels` on `frame`, written as
+    /// one 16-bit grey PNG spanning [0, 1] (`scale`: its range).
+    fn write_heights(&self, texels: &Texels, frame: Frame, name: &str) -> Result<Channels, String> {
+        let h = pov_bumps::heights(texels, frame);
+        if h.missed > pov_bumps::MAX_MISSED {
+            return Err(pov_bumps::not_a_height_field(h.missed));
+        }
+        let lo = h.values.iter().copied().fold(f64::INFINITY, f64::min);
+        let hi = h.values.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        let range = if hi > lo { hi - lo } else { 0.0 };
+        let px: Vec<u16> = h
+            .values
+            .iter()
+            .map(|&v| match range > 0.0 {
+                true => (((v - lo) / range).clamp(0.0, 1.0) * 65535.0).round() as u16,
+                false => 0,
+            })
+            .collect();
+        let img = image::ImageBuffer::<image::Luma<u16>, _>::from_raw(h.width, h.height, px)
+            .ok_or("internal error: height count")?;
+        img.save(self.dir.join(name))
+            .map_err(|e| format!("normal_map: writing {name} for POV-Ray: {e}"))?;
+        Ok(Channels {
+            files: vec![name.to_string()],
+            scale: range,
+            levels: Vec::new(),
+        })
+    }
 }
 
 #[cfg(test)]
@@ -136,8 +183,12 @@ mod tests {
             .unwrap();
         let t = TextureRef::File(file.to_string_lossy().into_owned());
         let maps = PovMaps::new(dir.path());
-        assert!(maps.get(&t, MapKind::Specular).unwrap().levels.is_empty());
-        let l = &maps.get(&t, MapKind::Shininess).unwrap().levels;
+        assert!(maps
+            .get(&t, MapKind::Specular, None)
+            .unwrap()
+            .levels
+            .is_empty());
+        let l = &maps.get(&t, MapKind::Shininess, None).unwrap().levels;
         assert_eq!(l.len(), 2, "{l:?}");
     }
 

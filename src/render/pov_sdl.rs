@@ -53,6 +53,7 @@
 //!   on glass, a specular or shininess map beside `specular2`.
 
 use super::backend::Refusal;
+use super::pov_bumps::{self, Frame};
 use super::pov_maps::Channels;
 use crate::math::V3;
 use crate::scene::pinhole::Pinhole;
@@ -176,12 +177,13 @@ fn fade(p: f64) -> (f64, String) {
 }
 
 /// Where the SDL finds a map's files (`pov_maps::PovMaps::get`).
-pub type MapSource<'a> = &'a dyn Fn(&TextureRef, MapKind) -> Result<Arc<Channels>, String>;
+pub type MapSource<'a> =
+    &'a dyn Fn(&TextureRef, MapKind, Option<Frame>) -> Result<Arc<Channels>, String>;
 
 /// The scene file POV-Ray renders, for a scene without texture maps (a
 /// map needs files in a run directory: `sdl_with`).
 pub fn sdl(scene: &Scene) -> Result<String, String> {
-    sdl_with(scene, &|_, k| {
+    sdl_with(scene, &|_, k, _| {
         Err(format!("{}: no run directory to write it into", k.key()))
     })
 }
@@ -466,7 +468,7 @@ fn material(m: &Material) -> String {
     } else {
         String::new()
     };
-    let layer = second_lobe(m, t);
+    let layer = second_lobe(m, t, "");
     format!("texture {{ pigment {{ {pigment} }} finish {{ {finish} }} }}{layer}{interior}")
 }
 
@@ -493,14 +495,15 @@ fn finish(m: &Material, opacity: f64, ks_scale: f64) -> String {
     finish
 }
 
-/// The second lobe as a transparent layer on top (none on glass).
-fn second_lobe(m: &Material, t: f64) -> String {
+/// The second lobe as a transparent layer on top (none on glass), its
+/// surface perturbed by `normal` as the layer below is.
+fn second_lobe(m: &Material, t: f64, normal: &str) -> String {
     let mut layer = String::new();
     if let Some(ks2) = m.specular2.filter(|&k| k > 0.0 && t == 0.0) {
         let n2 = m.shininess2.unwrap_or(m.shininess);
         let _ = write!(
             layer,
-            " texture {{ pigment {{ rgbt <1, 1, 1, 1> }} finish {{ ambient 0 diffuse 0 specular {} roughness {} }} }}",
+            " texture {{ pigment {{ rgbt <1, 1, 1, 1> }}{normal} finish {{ ambient 0 diffuse 0 specular {} roughness {} }} }}",
             num(ks2 * (n2 + 8.0) / (8.0 * PI)),
             num(1.0 / n2.max(1e-9))
         );
@@ -525,13 +528,20 @@ fn mapped_material(o: &Object, maps: MapSource) -> Result<String, String> {
         Some(t) => mapped_pigment(o, maps, Some(t))?,
         None => in_specular.clone(),
     };
-    let with = |pigment: &str, mat: &Material, ks: f64| {
+    let normal_in_specular = mapped_normal(o, maps, m.specular_map.as_ref())?;
+    let normal_in_shininess = match &m.shininess_map {
+        Some(t) => mapped_normal(o, maps, Some(t))?,
+        None => normal_in_specular.clone(),
+    };
+    let with = |(pigment, normal): (&str, &str), mat: &Material, ks: f64| {
         format!(
-            "pigment {{ {pigment} }} finish {{ {} }}",
+            "pigment {{ {pigment} }}{normal} finish {{ {} }}",
             finish(mat, 1.0, ks)
         )
     };
-    let base = |mat: &Material, ks: f64| with(&in_specular, mat, ks);
+    let in_spec = (&in_specular[..], &normal_in_specular[..]);
+    let in_shine = (&in_shininess[..], &normal_in_shininess[..]);
+    let base = |mat: &Material, ks: f64| with(in_spec, mat, ks);
     // The texture with its highlight (ks x `ks`): at the material's
     // exponent, or per texel at the shininess map's.
     let lit = |ks: f64| -> Result<String, String> {
@@ -542,7 +552,7 @@ fn mapped_material(o: &Object, maps: MapSource) -> Result<String, String> {
         let at = |n: f64| {
             let mut mat = m.clone();
             mat.shininess = n;
-            with(&in_shininess, &mat, ks)
+            with(in_shine, &mat, ks)
         };
         if let [n] = ch.levels[..] {
             // One exponent: no pattern, so the pigment sits where `base` is.
@@ -561,7 +571,11 @@ fn mapped_material(o: &Object, maps: MapSource) -> Result<String, String> {
         ))
     };
     Ok(match &m.specular_map {
-        None => format!("texture {{ {} }}{}", lit(1.0)?, second_lobe(m, 0.0)),
+        None => format!(
+            "texture {{ {} }}{}",
+            lit(1.0)?,
+            second_lobe(m, 0.0, &normal_in_specular)
+        ),
         Some(t) => {
             let (ch, pre, post) = get(MapKind::Specular, t, None)?;
             format!(
@@ -586,7 +600,16 @@ fn placed(
     t: &TextureRef,
     outer: Option<&TextureRef>,
 ) -> Result<(Arc<Channels>, String, String), String> {
-    let ch = maps(t, k).map_err(|e| format!("objects.{}.material.{e}", o.name))?;
+    let frame = match k {
+        MapKind::Normal => Some(pov_bumps::planar_frame(&o.shape, t.scale()).ok_or_else(|| {
+            format!(
+                "objects.{}.material.normal_map: drawn by POV-Ray on a plane or quad only",
+                o.name
+            )
+        })?),
+        _ => None,
+    };
+    let ch = maps(t, k, frame).map_err(|e| format!("objects.{}.material.{e}", o.name))?;
     let (pre, mut post) = mapping(&o.shape, t.scale()).ok_or_else(|| {
         format!(
             "objects.{}.material.{}: not drawn on this shape by POV-Ray",
@@ -629,6 +652,41 @@ fn mapped_pigment(
     Ok(format!("average pigment_map {{{entries} }}"))
 }
 
+/// The surface's normal perturbed by its normal map (`pov_bumps`: the
+/// height field of its slopes, `scale` its range in world length) as a
+/// pattern's gradient, placed for the patterned texture it sits in; ""
+/// without a normal map. POV-Ray adds `-BUMP_GAIN bump_size` times the
+/// pattern's gradient to the normal (four samples `accuracy` apart; the
+/// gain measured), so `bump_size` is the height's range over the gain.
+fn mapped_normal(
+    o: &Object,
+    maps: MapSource,
+    outer: Option<&TextureRef>,
+) -> Result<String, String> {
+    let Some(t) = &o.material.normal_map else {
+        return Ok(String::new());
+    };
+    let (ch, pre, post) = placed(o, maps, MapKind::Normal, t, outer)?;
+    if ch.scale <= 0.0 {
+        return Ok(String::new());
+    }
+    Ok(format!(
+        " normal {{ {pre}{} bump_size {} accuracy {}{post} }}",
+        pattern(&ch.files[0]),
+        num(ch.scale / BUMP_GAIN),
+        num(BUMP_ACCURACY)
+    ))
+}
+
+/// What POV-Ray's `normal` adds per unit of `bump_size` and of the
+/// pattern's gradient: 5 x 0.02 (its two fixed factors) x 4/3 (the sum
+/// of its four sample directions' outer products).
+const BUMP_GAIN: f64 = 0.4 / 3.0;
+
+/// The step of POV-Ray's gradient, in the map's coordinates: far inside
+/// one cell of the height field (`pov_bumps`, at most 1024 a side).
+const BUMP_ACCURACY: f64 = 1e-4;
+
 /// A written map file as a bilinear, linear pattern (`pov_maps`).
 fn pattern(file: &str) -> String {
     format!("image_pattern {{ png \"{file}\" gamma 1.0 interpolate 2 }}")
@@ -646,12 +704,17 @@ fn mapping(shape: &Shape, scale: [f64; 2]) -> Option<(String, String)> {
         num(1.0 / scale[0]),
         num(1.0 / scale[1])
     );
+    // The scale folded into the one matrix: POV-Ray turns a normal
+    // pattern's gradient back through its transforms in the wrong order
+    // (measured: a `scale` before a `matrix` tilts an anisotropic map's
+    // bumps), which one transform cannot.
     let frame = |u: Vec3, v: Vec3, n: Vec3, at: Vec3| {
+        let (u, v) = (u.map(|x| x / scale[0]), v.map(|x| x / scale[1]));
         let m: Vec<String> = [u, v, n, at]
             .iter()
             .flat_map(|x| pov(*x).map(num))
             .collect();
-        format!("{sc} matrix <{}>", m.join(", "))
+        format!(" matrix <{}>", m.join(", "))
     };
     match *shape {
         Shape::Sphere { .. } | Shape::Mesh { .. } => Some(("uv_mapping ".into(), sc)),

@@ -77,7 +77,7 @@ impl OneShotBackend for PovBackend {
     }
 
     fn scene_text(&self, scene: &Scene) -> std::result::Result<String, String> {
-        let text = pov_sdl::sdl_with(scene, &|t, k| self.maps.get(t, k))?;
+        let text = pov_sdl::sdl_with(scene, &|t, k, f| self.maps.get(t, k, f))?;
         only_version_directive(&text)?;
         Ok(text)
     }

@@ -52,7 +52,16 @@ fn scene_for(field: &str) -> Scene {
             m.specular_map = Some(TextureRef::File("t.png".into()));
             m.specular2 = Some(0.2);
         }
-        "`material.normal_map`" => m.normal_map = Some(TextureRef::File("t.png".into())),
+        "`material.normal_map` on a `sphere` or `mesh`" => {
+            m.normal_map = Some(TextureRef::File("t.png".into()))
+        }
+        "a `normal_map` on a `plane` or `quad` more than 5 % of whose slopes are not a height field's there" => {
+            m.normal_map = Some(TextureRef::File(twisted_normal_map()));
+            s.objects[0].shape = serde_json::from_value(
+                serde_json::json!({"type": "quad", "corner": [0.0, 0.0, 0.0], "edge_u": [1.0, 0.0, 0.0], "edge_v": [0.0, 1.0, 0.0]}),
+            )
+            .unwrap();
+        }
         "a texture map on a `box`" => {
             m.color_map = Some(TextureRef::File("t.png".into()));
             s.objects[0].shape = serde_json::from_value(
@@ -86,6 +95,18 @@ fn scene_for(field: &str) -> Scene {
         other => panic!("docs/renderers.md refuses {other:?}: add a scene for it here"),
     }
     s
+}
+
+/// A normal map no height field has (the slope along u changes along v),
+/// written once into the system's temporary folder.
+fn twisted_normal_map() -> String {
+    let path = std::env::temp_dir().join(format!("scenefit_twisted_{}.png", std::process::id()));
+    let img = image::RgbImage::from_fn(16, 16, |_, y| {
+        let x = 0.3 * (std::f64::consts::TAU * (y as f64 + 0.5) / 16.0).cos();
+        image::Rgb([(255.0 * (x + 1.0) / 2.0).round() as u8, 128, 255])
+    });
+    img.save(&path).unwrap();
+    path.to_string_lossy().into_owned()
 }
 
 /// The registry's names that a cell mentions.
