@@ -10,6 +10,8 @@
 
 mod common;
 use common::*;
+#[path = "backends_common/mod.rs"]
+mod backends;
 use scenefit::api::{self, Image, RenderOptions};
 use serde_json::{json, Value};
 use std::path::Path;
@@ -169,28 +171,45 @@ fn a_degenerate_uv_triangle_falls_back_to_its_own_frame() {
     }
 }
 
-/// POV-Ray refuses the normal map, naming the field, before it starts.
+/// POV-Ray refuses a normal map on a sphere, and on a quad one that no
+/// height field has (one tilt everywhere: a height that repeats cannot
+/// slope one way throughout), naming the field, before it starts; a flat
+/// map on a quad it draws.
 #[test]
-fn povray_refuses_the_normal_map_naming_the_field() {
+fn povray_refuses_a_normal_map_it_cannot_draw_naming_the_field() {
     let d = tempfile::tempdir().unwrap();
     texel(&d.path().join("flat.png"), [0.5, 0.5, 1.0]);
-    let m = json!({"color": [0.9, 0.9, 0.9], "normal_map": "flat.png"});
-    scene(d.path(), quad(m, None), [0.0, 0.0, 1.0]);
-    let o = scenefit(
-        d.path(),
-        &[
-            "render",
-            "scene.json",
-            "-o",
-            "o.png",
-            "--renderer",
-            "povray",
-        ],
-    );
-    let err = stderr(&o);
-    assert_eq!(o.status.code(), Some(2), "{err}");
-    assert!(err.contains("objects.tile.material.normal_map"), "{err}");
-    assert!(!d.path().join("o.png").exists());
+    texel(&d.path().join("tilt.png"), [0.7, 0.5, 0.9]);
+    let povray = [
+        "render",
+        "scene.json",
+        "-o",
+        "o.png",
+        "--renderer",
+        "povray",
+    ];
+    let ball = |map: &str| {
+        json!({"name": "ball", "shape": {"type": "sphere", "center": [0, 0, 0], "radius": 0.8},
+            "material": {"color": [0.9, 0.9, 0.9], "normal_map": map}})
+    };
+    let tile = |map: &str| quad(json!({"color": [0.9, 0.9, 0.9], "normal_map": map}), None);
+    for (object, field) in [
+        (ball("flat.png"), "objects.ball.material.normal_map"),
+        (tile("tilt.png"), "objects.tile.material.normal_map"),
+    ] {
+        scene(d.path(), object, [0.0, 0.0, 1.0]);
+        let o = scenefit(d.path(), &povray);
+        let err = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{err}");
+        assert!(err.contains(field) && err.lines().count() == 1, "{err}");
+        assert!(!d.path().join("o.png").exists());
+    }
+    if backends::have("povray", "POV-Ray") {
+        scene(d.path(), tile("flat.png"), [0.0, 0.0, 1.0]);
+        let o = scenefit(d.path(), &povray);
+        assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+        assert!(d.path().join("o.png").exists());
+    }
 }
 
 /// Bad normal map files: one line naming the scene file, the key and the

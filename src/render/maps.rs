@@ -51,8 +51,8 @@ pub fn povray_refusals(scene: &Scene) -> Vec<Refusal> {
         if let Some(t) = m.normal_map.as_ref().filter(|_| planar) {
             let frame = super::pov_bumps::planar_frame(&o.shape, t.scale());
             // an unreadable file is the scene check's to report
-            let missed = frame.and_then(|f| super::pov_bumps::missed(t, f).ok());
-            if let Some(m) = missed.filter(|&m| m > super::pov_bumps::MAX_MISSED) {
+            let missed = frame.and_then(|f| super::pov_bumps::missed(t, f).ok().flatten());
+            if let Some(m) = missed {
                 let why = super::pov_bumps::not_a_height_field(m);
                 out.push(Refusal::new(
                     format!("objects.{}.material.normal_map", o.name),

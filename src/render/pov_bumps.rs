@@ -41,6 +41,18 @@ const MIN_Z: f64 = 0.02;
 /// 1-4 % off over the image. A map is refused above it.
 pub const MAX_MISSED: f64 = 0.05;
 
+/// A misfit of at most this slope (root mean square, about 0.6 degrees:
+/// less than one 8-bit level of a map's x or y) is drawn whatever its
+/// share: a flat map written at 16 bits is a tilt of 1e-5 everywhere,
+/// all of which no height has.
+pub const MIN_SLOPE: f64 = 0.01;
+
+/// Whether a normal map is refused: a share `h.missed` above
+/// `MAX_MISSED` that is more than `MIN_SLOPE` of slope.
+pub fn refused(h: &Heights) -> bool {
+    h.missed > MAX_MISSED && h.missed * h.slope > MIN_SLOPE
+}
+
 /// The refusal of a normal map whose slopes are `missed` away from any
 /// height field's on its surface.
 pub fn not_a_height_field(missed: f64) -> String {
@@ -52,18 +64,20 @@ pub fn not_a_height_field(missed: f64) -> String {
 }
 
 /// The share `heights` misses of the normal map `t` on `frame` (read as
-/// the scene reads it); the last few asked are kept, since every render
-/// of a fit asks it again (`maps::povray_refusals`).
-pub fn missed(t: &TextureRef, frame: Frame) -> Result<f64, String> {
+/// the scene reads it) when it is refused (`refused`), else None; the
+/// last few asked are kept, since every render of a fit asks it again
+/// (`maps::povray_refusals`).
+pub fn missed(t: &TextureRef, frame: Frame) -> Result<Option<f64>, String> {
     type Key = (String, [u64; 4]);
-    static SEEN: Mutex<Vec<(Key, f64)>> = Mutex::new(Vec::new());
+    static SEEN: Mutex<Vec<(Key, Option<f64>)>> = Mutex::new(Vec::new());
     const KEPT: usize = 16;
     let key = (t.file().to_string(), frame.map(f64::to_bits));
     if let Some((_, m)) = SEEN.lock().expect("missed").iter().find(|(k, _)| *k == key) {
         return Ok(*m);
     }
     let texels = texture::get(std::path::Path::new(t.file()), t.encoding(MapKind::Normal))?;
-    let m = heights(&texels, frame).missed;
+    let h = heights(&texels, frame);
+    let m = refused(&h).then_some(h.missed);
     let mut seen = SEEN.lock().expect("missed");
     if seen.len() >= KEPT {
         seen.remove(0);
@@ -120,13 +134,15 @@ pub fn frame(es: [f64; 3], et: [f64; 3], n: [f64; 3]) -> Option<Frame> {
 }
 
 /// A height field: `width` x `height` values, rows top to bottom (as the
-/// map's), in world length; and the share of the map's slopes it misses
-/// (the root-mean-square misfit over the root-mean-square slope).
+/// map's), in world length; the share of the map's slopes it misses
+/// (the root-mean-square misfit over the root-mean-square slope), and
+/// that slope (rise over run on the surface).
 pub struct Heights {
     pub width: u32,
     pub height: u32,
     pub values: Vec<f64>,
     pub missed: f64,
+    pub slope: f64,
 }
 
 /// The height field whose slopes best match the normal map `texels` in
@@ -142,8 +158,9 @@ pub fn heights(texels: &Texels, frame: Frame) -> Heights {
         let z = b.max(MIN_Z);
         let (gx, gy) = (r / z, g / z);
         let [ts, bs, tt, bt] = frame;
-        (gx * ts + gy * bs, gx * tt + gy * bt)
+        (gx * ts + gy * bs, gx * tt + gy * bt, gx * gx + gy * gy)
     };
+    let mut slope2 = 0.0;
     // Height differences wanted between neighbours: to the right, along
     // +s; and down a row, along -t. The surface's gradient is -G, so
     // each slope is taken with its sign turned.
@@ -155,6 +172,7 @@ pub fn heights(texels: &Texels, frame: Frame) -> Heights {
             let t = 1.0 - (r as f64 + 0.5) / h as f64;
             dx[r * wn + i] = -slope(s + 0.5 / w as f64, t).0 / w as f64;
             dy[r * wn + i] = slope(s, t - 0.5 / h as f64).1 / h as f64;
+            slope2 += slope(s, t).2;
         }
     }
     let at = |i: usize, r: usize| r * wn + i;
@@ -185,6 +203,7 @@ pub fn heights(texels: &Texels, frame: Frame) -> Heights {
         } else {
             0.0
         },
+        slope: (slope2 / (wn * hn) as f64).sqrt(),
     }
 }
 

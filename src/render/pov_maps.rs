@@ -142,7 +142,7 @@ impl PovMaps {
     /// one 16-bit grey PNG spanning [0, 1] (`scale`: its range).
     fn write_heights(&self, texels: &Texels, frame: Frame, name: &str) -> Result<Channels, String> {
         let h = pov_bumps::heights(texels, frame);
-        if h.missed > pov_bumps::MAX_MISSED {
+        if pov_bumps::refused(&h) {
             return Err(pov_bumps::not_a_height_field(h.missed));
         }
         let lo = h.values.iter().copied().fold(f64::INFINITY, f64::min);
