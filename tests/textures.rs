@@ -494,7 +494,7 @@ fn povray_draws_the_three_maps_together_on_a_quad_and_a_plane() {
 
 /// POV-Ray draws a normal map on a plane or quad (the height field of
 /// its slopes, `render/pov_bumps.rs`) as the built-in tracer does: on a
-/// quad facing the camera, a turned quad holding the colour, specular
+/// quad turned and scaled by its transform, a turned quad holding the colour, specular
 /// and shininess maps too (the normal nested in their patterned
 /// textures), and a tilted plane; within 1 % over the image and within a
 /// quarter of what the normal map itself changes. A map stretched
@@ -520,12 +520,16 @@ fn povray_draws_a_normal_map_on_a_quad_and_a_plane_as_the_built_in_tracer_does()
     all["color_map"] = json!({"file": checker, "scale": [1, 1.5]});
     all["specular_map"] = json!({"file": stripes, "scale": [1, 2]});
     all["shininess_map"] = json!({"file": stripes, "range": [5, 60], "scale": [3, 1]});
-    let scene = |shape: &Value, material: &Value| {
+    let scene = |(shape, transform): (&Value, &Value), material: &Value| {
+        let mut object = json!({"name": "tile", "shape": shape, "material": material});
+        if !transform.is_null() {
+            object["transform"] = transform.clone();
+        }
         json!({"format": "scenefit-scene/1", "image": {"width": 128, "height": 128},
             "camera": {"type": "perspective", "position": [0, 0, 3], "look_at": [0, 0, 0], "fov_y_deg": 40},
             "render": {"samples": 64, "indirect": false, "antialias": 4},
             "lights": [{"name": "key", "type": "point", "position": [0.8, 0.6, 2], "intensity": 6.0}],
-            "objects": [{"name": "tile", "shape": shape, "material": material}]})
+            "objects": [object]})
     };
     let render = |s: &Value, backend: &str| {
         let p = d.path().join("normal.json");
@@ -534,10 +538,17 @@ fn povray_draws_a_normal_map_on_a_quad_and_a_plane_as_the_built_in_tracer_does()
         let r = api::renderer(backend, &RenderOptions::default()).unwrap();
         api::render(&scene, backend, r.as_ref(), 0)
     };
+    // turned and scaled (evenly) by its transform
+    let moved = json!({"rotate_deg": [20, 30, 0], "scale": 0.8});
+    let none = Value::Null;
     for (name, shape, material) in [
-        ("front quad", &front, &plain),
-        ("turned quad, three maps besides", &turned, &all),
-        ("tilted plane", &plane, &plain),
+        (
+            "quad turned and scaled by its transform",
+            (&front, &moved),
+            &plain,
+        ),
+        ("turned quad, three maps besides", (&turned, &none), &all),
+        ("tilted plane", (&plane, &none), &plain),
     ] {
         let mut mapped = material.clone();
         mapped["normal_map"] = normal.clone();
@@ -556,7 +567,7 @@ fn povray_draws_a_normal_map_on_a_quad_and_a_plane_as_the_built_in_tracer_does()
     }
     let mut stretched = plain.clone();
     stretched["normal_map"] = json!({"file": bumps, "scale": [1, 3]});
-    let refused = match render(&scene(&front, &stretched), "povray") {
+    let refused = match render(&scene((&front, &none), &stretched), "povray") {
         Ok(_) => panic!("a stretched normal map was drawn"),
         Err(e) => e.to_string(),
     };

@@ -60,6 +60,16 @@ pub fn povray_refusals(scene: &Scene) -> Vec<Refusal> {
                 ));
             }
         }
+        let uneven = o.transform.as_ref().and_then(|t| t.scale).is_some_and(|s| {
+            let [a, b, c] = s.axes();
+            (a - b).abs() > 1e-9 * a.abs() || (a - c).abs() > 1e-9 * a.abs()
+        });
+        if m.normal_map.is_some() && planar && uneven {
+            out.push(Refusal::new(
+                format!("objects.{}.transform.scale", o.name),
+                "a normal_map on an object scaled unevenly is not drawn by povray (it turns the height's gradient as a normal, the built-in tracer turns the map's frame); use phong, blender or mitsuba, or scale the shape itself",
+            ));
+        }
         if m.normal_map.is_some() && !planar {
             out.push(Refusal::new(
                 format!("objects.{}.material.normal_map", o.name),

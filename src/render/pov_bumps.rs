@@ -148,8 +148,13 @@ pub struct Heights {
 /// The height field whose slopes best match the normal map `texels` in
 /// `frame`, wrapped as the map repeats.
 pub fn heights(texels: &Texels, frame: Frame) -> Heights {
+    // A map larger than `MAX_SIDE` is sampled at it: the memory stays
+    // bounded whatever the file (up to `texture::read::MAX_TEXTURE_SIDE`).
     let f = FINE.min((MAX_SIDE / texels.width.max(texels.height).max(1)).max(1));
-    let (w, h) = (texels.width * f, texels.height * f);
+    let (w, h) = (
+        (texels.width * f).min(MAX_SIDE),
+        (texels.height * f).min(MAX_SIDE),
+    );
     let (wn, hn) = (w as usize, h as usize);
     // Slopes along +s and along +t (per unit of the map's coordinates) at
     // (s, t), from the bilinear lookup as the built-in tracer reads it.
@@ -301,6 +306,21 @@ mod tests {
         }
         assert!(worst < 0.002, "worst {worst} of amplitude 0.05");
         assert!(h.missed < 0.05, "missed {}", h.missed);
+    }
+
+    /// A map wider than `MAX_SIDE` is laid out at it, not at its own size.
+    #[test]
+    fn a_large_map_is_laid_out_at_most_max_side() {
+        let (w, h) = (2 * MAX_SIDE + 6, 3);
+        let texels = Texels {
+            width: w,
+            height: h,
+            values: [0.5, 0.5, 1.0].repeat((w * h) as usize),
+        };
+        let frame = frame([1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]).unwrap();
+        let hf = heights(&texels, frame);
+        assert_eq!((hf.width, hf.height), (MAX_SIDE, 3));
+        assert_eq!(hf.values.len(), (MAX_SIDE * 3) as usize);
     }
 
     #[test]

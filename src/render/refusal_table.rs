@@ -52,6 +52,15 @@ fn scene_for(field: &str) -> Scene {
             m.specular_map = Some(TextureRef::File("t.png".into()));
             m.specular2 = Some(0.2);
         }
+        "a `normal_map` on an object whose `transform.scale` differs between axes" => {
+            m.normal_map = Some(TextureRef::File("t.png".into()));
+            s.objects[0].shape = serde_json::from_value(
+                serde_json::json!({"type": "quad", "corner": [0.0, 0.0, 0.0], "edge_u": [1.0, 0.0, 0.0], "edge_v": [0.0, 1.0, 0.0]}),
+            )
+            .unwrap();
+            s.objects[0].transform =
+                serde_json::from_value(serde_json::json!({"scale": [1.0, 2.0, 1.0]})).unwrap();
+        }
         "`material.normal_map` on a `sphere` or `mesh`" => {
             m.normal_map = Some(TextureRef::File("t.png".into()))
         }
