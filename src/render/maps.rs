@@ -56,7 +56,7 @@ pub fn povray_refusals(scene: &Scene) -> Vec<Refusal> {
                 let why = super::pov_bumps::not_a_height_field(m);
                 out.push(Refusal::new(
                     format!("objects.{}.material.normal_map", o.name),
-                    why.trim_start_matches("normal_map: ").to_string(),
+                    why,
                 ));
             }
         }

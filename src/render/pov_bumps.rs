@@ -23,7 +23,7 @@ use crate::scene::texture::{self, MapKind, Texels, TextureRef};
 use crate::scene::Shape;
 use rustfft::num_complex::Complex;
 use rustfft::FftPlanner;
-use std::sync::Mutex;
+use std::sync::{Arc, Mutex};
 
 /// The height field is laid out this many times finer than the map, at
 /// most `MAX_SIDE` texels a side.
@@ -53,37 +53,54 @@ pub fn refused(h: &Heights) -> bool {
     h.missed > MAX_MISSED && h.missed * h.slope > MIN_SLOPE
 }
 
-/// The refusal of a normal map whose slopes are `missed` away from any
-/// height field's on its surface.
+/// Why a normal map is refused whose slopes are `missed` away from any
+/// height field's on its surface (the caller names the field).
 pub fn not_a_height_field(missed: f64) -> String {
     format!(
-        "normal_map: {:.0} % of its slopes are not a height field's on this surface (at most {:.0} %: a map stretched unevenly by `scale` or the shape, or twisted), and POV-Ray draws a normal map as a height's gradient; use phong, blender or mitsuba, or a map made for this scale",
+        "{:.0} % of its slopes are not a height field's on this surface (at most {:.0} %: a map stretched unevenly by `scale` or the shape, or twisted), and POV-Ray draws a normal map as a height's gradient; use phong, blender or mitsuba, or a map made for this scale",
         100.0 * missed,
         100.0 * MAX_MISSED
     )
 }
 
-/// The share `heights` misses of the normal map `t` on `frame` (read as
-/// the scene reads it) when it is refused (`refused`), else None; the
-/// last few asked are kept, since every render of a fit asks it again
-/// (`maps::povray_refusals`).
-pub fn missed(t: &TextureRef, frame: Frame) -> Result<Option<f64>, String> {
-    type Key = (String, [u64; 4]);
-    static SEEN: Mutex<Vec<(Key, Option<f64>)>> = Mutex::new(Vec::new());
-    const KEPT: usize = 16;
-    let key = (t.file().to_string(), frame.map(f64::to_bits));
-    if let Some((_, m)) = SEEN.lock().expect("missed").iter().find(|(k, _)| *k == key) {
-        return Ok(*m);
+/// The height field of the normal map `t` (read as the scene reads it,
+/// its `range` applied) on `frame`. The last few are kept: the refusal
+/// check (`maps::povray_refusals`) asks on every render of a fit, and
+/// the map's writer (`PovMaps`) once a session; each is solved once.
+/// At most `KEPT` x 8 MB (`MAX_SIDE` squared values).
+pub fn solved(t: &TextureRef, frame: Frame) -> Result<Arc<Heights>, String> {
+    type Key = (String, [u64; 2], [u64; 4]);
+    static SEEN: Mutex<Vec<(Key, Arc<Heights>)>> = Mutex::new(Vec::new());
+    const KEPT: usize = 4;
+    let range = t.range();
+    let key = (
+        t.file().to_string(),
+        range.map(f64::to_bits),
+        frame.map(f64::to_bits),
+    );
+    if let Some((_, h)) = SEEN
+        .lock()
+        .expect("heights")
+        .iter()
+        .find(|(k, _)| *k == key)
+    {
+        return Ok(h.clone());
     }
     let texels = texture::get(std::path::Path::new(t.file()), t.encoding(MapKind::Normal))?;
-    let h = heights(&texels, frame);
-    let m = refused(&h).then_some(h.missed);
-    let mut seen = SEEN.lock().expect("missed");
+    let h = Arc::new(heights(&texels, range, frame));
+    let mut seen = SEEN.lock().expect("heights");
     if seen.len() >= KEPT {
         seen.remove(0);
     }
-    seen.push((key, m));
-    Ok(m)
+    seen.push((key, h.clone()));
+    Ok(h)
+}
+
+/// The share of its slopes the height field of normal map `t` on `frame`
+/// misses when it is refused (`refused`), else None.
+pub fn missed(t: &TextureRef, frame: Frame) -> Result<Option<f64>, String> {
+    let h = solved(t, frame)?;
+    Ok(refused(&h).then_some(h.missed))
 }
 
 /// A planar map's frame (None on a sphere, box or mesh): from the world
@@ -145,9 +162,10 @@ pub struct Heights {
     pub slope: f64,
 }
 
-/// The height field whose slopes best match the normal map `texels` in
-/// `frame`, wrapped as the map repeats.
-pub fn heights(texels: &Texels, frame: Frame) -> Heights {
+/// The height field whose slopes best match the normal map `texels`,
+/// each value read as `lo + v (hi - lo)` for `range` [lo, hi] as the
+/// built-in tracer reads it, in `frame`, wrapped as the map repeats.
+pub fn heights(texels: &Texels, range: [f64; 2], frame: Frame) -> Heights {
     // A map larger than `MAX_SIDE` is sampled at it: the memory stays
     // bounded whatever the file (up to `texture::read::MAX_TEXTURE_SIDE`).
     let f = FINE.min((MAX_SIDE / texels.width.max(texels.height).max(1)).max(1));
@@ -159,7 +177,10 @@ pub fn heights(texels: &Texels, frame: Frame) -> Heights {
     // Slopes along +s and along +t (per unit of the map's coordinates) at
     // (s, t), from the bilinear lookup as the built-in tracer reads it.
     let slope = |s: f64, t: f64| {
-        let [r, g, b] = texels.sample(s, t).map(|c| 2.0 * c as f64 - 1.0);
+        let [lo, hi] = range;
+        let [r, g, b] = texels
+            .sample(s, t)
+            .map(|c| 2.0 * (lo + c as f64 * (hi - lo)) - 1.0);
         let z = b.max(MIN_Z);
         let (gx, gy) = (r / z, g / z);
         let [ts, bs, tt, bt] = frame;
@@ -291,7 +312,7 @@ mod tests {
     #[test]
     fn a_height_fields_normal_map_gives_that_height_back() {
         let (texels, frame) = from_height(32, 0.05);
-        let h = heights(&texels, frame);
+        let h = heights(&texels, [0.0, 1.0], frame);
         assert_eq!((h.width, h.height), (128, 128));
         let tau = std::f64::consts::TAU;
         let mean = h.values.iter().sum::<f64>() / h.values.len() as f64;
@@ -318,7 +339,7 @@ mod tests {
             values: [0.5, 0.5, 1.0].repeat((w * h) as usize),
         };
         let frame = frame([1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]).unwrap();
-        let hf = heights(&texels, frame);
+        let hf = heights(&texels, [0.0, 1.0], frame);
         assert_eq!((hf.width, hf.height), (MAX_SIDE, 3));
         assert_eq!(hf.values.len(), (MAX_SIDE * 3) as usize);
     }
@@ -342,6 +363,38 @@ mod tests {
             values,
         };
         let frame = frame([1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]).unwrap();
-        assert!(heights(&texels, frame).missed > 0.9);
+        assert!(heights(&texels, [0.0, 1.0], frame).missed > 0.9);
+    }
+
+    /// A map stored with a `range`: its texels are read as
+    /// lo + v (hi - lo) before they are vectors, so the same normals
+    /// written into [lo, hi] give the same height.
+    #[test]
+    fn a_maps_range_is_applied_before_its_slopes() {
+        let (plain, frame) = from_height(16, 0.05);
+        let [lo, hi] = [0.3, 1.1];
+        let stored = Texels {
+            values: plain
+                .values
+                .iter()
+                .map(|&v| ((v as f64 - lo) / (hi - lo)) as f32)
+                .collect(),
+            ..plain
+        };
+        let a = heights(&plain, [0.0, 1.0], frame);
+        let b = heights(&stored, [lo, hi], frame);
+        let worst = a
+            .values
+            .iter()
+            .zip(&b.values)
+            .fold(0.0f64, |w, (x, y)| w.max((x - y).abs()));
+        assert!(worst < 1e-6, "heights differ by {worst}");
+        let unread = heights(&stored, [0.0, 1.0], frame);
+        let off = a
+            .values
+            .iter()
+            .zip(&unread.values)
+            .fold(0.0f64, |w, (x, y)| w.max((x - y).abs()));
+        assert!(off > 0.01, "the range changes nothing here: {off}");
     }
 }

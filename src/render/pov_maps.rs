@@ -7,7 +7,7 @@
 //! only these files (`m0r.png`, ...), never a path from the scene.
 
 use super::pov_bumps::{self, Frame};
-use crate::scene::texture::{self, Encoding, MapKind, Texels, TextureRef};
+use crate::scene::texture::{self, Encoding, MapKind, TextureRef};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
@@ -90,15 +90,15 @@ impl PovMaps {
         if let Some(c) = written.get(&key) {
             return Ok(c.clone());
         }
-        let texels = texture::get(Path::new(t.file()), enc)
-            .map_err(|e| format!("{}: {}: {e}", kind.key(), t.file()))?;
         if kind == MapKind::Normal {
             let frame = frame.ok_or("normal_map: drawn by POV-Ray on a plane or quad only")?;
             let name = format!("m{}h.png", written.len());
-            let c = Arc::new(self.write_heights(&texels, frame, &name)?);
+            let c = Arc::new(self.write_heights(t, frame, &name)?);
             written.insert(key, c.clone());
             return Ok(c);
         }
+        let texels = texture::get(Path::new(t.file()), enc)
+            .map_err(|e| format!("{}: {}: {e}", kind.key(), t.file()))?;
         let values: Vec<f64> = texels
             .values
             .iter()
@@ -138,12 +138,15 @@ impl PovMaps {
         Ok(c)
     }
 
-    /// The height field of the normal map `texels` on `frame`, written as
-    /// one 16-bit grey PNG spanning [0, 1] (`scale`: its range).
-    fn write_heights(&self, texels: &Texels, frame: Frame, name: &str) -> Result<Channels, String> {
-        let h = pov_bumps::heights(texels, frame);
+    /// The height field of the normal map `t` on `frame`, written as one
+    /// 16-bit grey PNG spanning [0, 1] (`scale`: its range). The refusal
+    /// is the scene check's (`maps::povray_refusals`); this is its guard.
+    fn write_heights(&self, t: &TextureRef, frame: Frame, name: &str) -> Result<Channels, String> {
+        let h =
+            pov_bumps::solved(t, frame).map_err(|e| format!("normal_map: {}: {e}", t.file()))?;
         if pov_bumps::refused(&h) {
-            return Err(pov_bumps::not_a_height_field(h.missed));
+            let why = pov_bumps::not_a_height_field(h.missed);
+            return Err(format!("normal_map: {why}"));
         }
         let lo = h.values.iter().copied().fold(f64::INFINITY, f64::min);
         let hi = h.values.iter().copied().fold(f64::NEG_INFINITY, f64::max);
