@@ -460,6 +460,16 @@ fn povray_draws_the_colour_specular_and_shininess_maps_as_the_built_in_tracer_do
     );
 }
 
+/// One object `tile` seen from 3 m, 128 x 128, under one point light at
+/// `light`: the scene of POV-Ray's planar-map agreement tests.
+fn tile_scene(tile: Value, light: [f64; 3]) -> Value {
+    json!({"format": "scenefit-scene/1", "image": {"width": 128, "height": 128},
+        "camera": {"type": "perspective", "position": [0, 0, 3], "look_at": [0, 0, 0], "fov_y_deg": 40},
+        "render": {"samples": 64, "indirect": false, "antialias": 4},
+        "lights": [{"name": "key", "type": "point", "position": light, "intensity": 6.0}],
+        "objects": [tile]})
+}
+
 /// The three maps together on a planar map, at three scales, where the
 /// colour pattern sits inside both patterned textures and is carried by
 /// both their transforms: POV-Ray draws a quad filling the view and a
@@ -476,15 +486,12 @@ fn povray_draws_the_three_maps_together_on_a_quad_and_a_plane() {
     let quad = json!({"type": "quad", "corner": [-0.9, -0.9, 0], "edge_u": [1.8, 0, 0], "edge_v": [0, 1.8, 0]});
     let plane = json!({"type": "plane", "point": [0, -0.5, 0], "normal": [0, 1, 0.4]});
     for (name, shape) in [("quad", quad), ("plane", plane)] {
-        let s = json!({"format": "scenefit-scene/1", "image": {"width": 128, "height": 128},
-            "camera": {"type": "perspective", "position": [0, 0, 3], "look_at": [0, 0, 0], "fov_y_deg": 40},
-            "render": {"samples": 64, "indirect": false, "antialias": 4},
-            "lights": [{"name": "key", "type": "point", "position": [0.3, 0.2, 2], "intensity": 6.0}],
-            "objects": [{"name": "tile", "shape": shape,
-                "material": {"color": [0.3, 0.3, 0.3], "specular": 0.6, "shininess": 30,
-                    "specular_map": {"file": stripes, "scale": [1, 2]},
-                    "shininess_map": {"file": stripes, "range": [5, 60], "scale": [3, 1]},
-                    "color_map": {"file": checker, "scale": [1, 1.5]}}}]});
+        let tile = json!({"name": "tile", "shape": shape,
+            "material": {"color": [0.3, 0.3, 0.3], "specular": 0.6, "shininess": 30,
+                "specular_map": {"file": stripes, "scale": [1, 2]},
+                "shininess_map": {"file": stripes, "range": [5, 60], "scale": [3, 1]},
+                "color_map": {"file": checker, "scale": [1, 1.5]}}});
+        let s = tile_scene(tile, [0.3, 0.2, 2.0]);
         let p = d.path().join(format!("three_maps_{name}.json"));
         std::fs::write(&p, s.to_string()).unwrap();
         let dev = agreement(&p, "povray");
@@ -525,11 +532,7 @@ fn povray_draws_a_normal_map_on_a_quad_and_a_plane_as_the_built_in_tracer_does()
         if !transform.is_null() {
             object["transform"] = transform.clone();
         }
-        json!({"format": "scenefit-scene/1", "image": {"width": 128, "height": 128},
-            "camera": {"type": "perspective", "position": [0, 0, 3], "look_at": [0, 0, 0], "fov_y_deg": 40},
-            "render": {"samples": 64, "indirect": false, "antialias": 4},
-            "lights": [{"name": "key", "type": "point", "position": [0.8, 0.6, 2], "intensity": 6.0}],
-            "objects": [object]})
+        tile_scene(object, [0.8, 0.6, 2.0])
     };
     let render = |s: &Value, backend: &str| {
         let p = d.path().join("normal.json");

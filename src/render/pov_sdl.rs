@@ -523,15 +523,10 @@ fn mapped_material(o: &Object, maps: MapSource) -> Result<String, String> {
     // On a planar map a nested pattern is carried by every enclosing
     // pattern's transform, so the pigment is placed for the texture it
     // sits in: the specular map's entries, or the shininess map's.
-    let in_specular = mapped_pigment(o, maps, m.specular_map.as_ref())?;
+    let in_specular = surface(o, maps, m.specular_map.as_ref())?;
     let in_shininess = match &m.shininess_map {
-        Some(t) => mapped_pigment(o, maps, Some(t))?,
+        Some(t) => surface(o, maps, Some(t))?,
         None => in_specular.clone(),
-    };
-    let normal_in_specular = mapped_normal(o, maps, m.specular_map.as_ref())?;
-    let normal_in_shininess = match &m.shininess_map {
-        Some(t) => mapped_normal(o, maps, Some(t))?,
-        None => normal_in_specular.clone(),
     };
     let with = |(pigment, normal): (&str, &str), mat: &Material, ks: f64| {
         format!(
@@ -539,8 +534,8 @@ fn mapped_material(o: &Object, maps: MapSource) -> Result<String, String> {
             finish(mat, 1.0, ks)
         )
     };
-    let in_spec = (&in_specular[..], &normal_in_specular[..]);
-    let in_shine = (&in_shininess[..], &normal_in_shininess[..]);
+    let in_spec = (&in_specular.0[..], &in_specular.1[..]);
+    let in_shine = (&in_shininess.0[..], &in_shininess.1[..]);
     let base = |mat: &Material, ks: f64| with(in_spec, mat, ks);
     // The texture with its highlight (ks x `ks`): at the material's
     // exponent, or per texel at the shininess map's.
@@ -574,7 +569,7 @@ fn mapped_material(o: &Object, maps: MapSource) -> Result<String, String> {
         None => format!(
             "texture {{ {} }}{}",
             lit(1.0)?,
-            second_lobe(m, 0.0, &normal_in_specular)
+            second_lobe(m, 0.0, &in_specular.1)
         ),
         Some(t) => {
             let (ch, pre, post) = get(MapKind::Specular, t, None)?;
@@ -586,6 +581,19 @@ fn mapped_material(o: &Object, maps: MapSource) -> Result<String, String> {
             )
         }
     })
+}
+
+/// The pigment and the normal of a material with maps, placed for the
+/// patterned texture they sit in (`outer`'s map; None: none).
+fn surface(
+    o: &Object,
+    maps: MapSource,
+    outer: Option<&TextureRef>,
+) -> Result<(String, String), String> {
+    Ok((
+        mapped_pigment(o, maps, outer)?,
+        mapped_normal(o, maps, outer)?,
+    ))
 }
 
 /// Map `t` of kind `k` as POV-Ray reads it: its files, and what goes
