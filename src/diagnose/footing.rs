@@ -34,10 +34,12 @@ use crate::error::Result;
 /// Weighs `found` (refitted into `models`, in order) from `model` again
 /// on the texture-free footing, over `n` channel values, in round
 /// `round`; a candidate whose criterion is lower there takes that
-/// footing's criterion, gain and overdispersion.
+/// footing's criterion, gain and overdispersion. `null`: the unchanged
+/// model refitted as the candidates were; its texture-free SAD is the
+/// baseline when lower (the drift of a refit is no effect's).
 pub(super) fn weigh_texture_free(
     fits: &mut Refits,
-    model: &Model,
+    (model, null): (&Model, Option<&Model>),
     found: &mut [Candidate],
     models: &[Model],
     n: f64,
@@ -52,6 +54,13 @@ pub(super) fn weigh_texture_free(
     let Some((before, at)) = texture_free(fits, model, &tag, None)? else {
         return Ok(());
     };
+    let mut before_sad = before.sad;
+    if let Some(null) = null {
+        let tag = format!("round{round}_free_null");
+        if let Some((m, _)) = texture_free(fits, null, &tag, Some(&at))? {
+            before_sad = before_sad.min(m.sad);
+        }
+    }
     let mut mapped: Vec<Option<Model>> = Vec::with_capacity(found.len());
     for (cand, m) in found.iter().zip(models) {
         let searched = effects::by_name(&cand.effect).is_some_and(|e| !e.closed_form());
@@ -75,8 +84,8 @@ pub(super) fn weigh_texture_free(
         let Some(m) = m else { continue };
         let (plain_delta_bic, plain_gain) =
             (cand.delta_bic.unwrap_or(0.0), cand.gain.unwrap_or(0.0));
-        let free_delta_bic = delta_bic(before.sad, m.sad, n, cand.added_params, c);
-        let free_gain = 1.0 - m.sad / before.sad.max(1e-9);
+        let free_delta_bic = delta_bic(before_sad, m.sad, n, cand.added_params, c);
+        let free_gain = 1.0 - m.sad / before_sad.max(1e-9);
         let free = free_delta_bic < plain_delta_bic;
         if free {
             cand.delta_bic = Some(free_delta_bic);

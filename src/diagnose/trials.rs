@@ -133,6 +133,18 @@ impl Refits<'_> {
         }
     }
 
+    /// The unchanged model refitted as a round's searched candidates are
+    /// (a set's warm refit), the baseline of that round's gains: what
+    /// the refit reaches without any effect is credited to none. None for
+    /// one photograph, whose candidates are measured against the model
+    /// refitted once before the rounds and polished when accepted.
+    pub(super) fn null(&mut self, model: &Model) -> Result<Option<Model>> {
+        match self.schedule {
+            Schedule::One => Ok(None),
+            Schedule::Set => self.run_set(&model.scene, &model.own).map(Some),
+        }
+    }
+
     /// `scene` with `own` values refitted warm: the refit of a rebuilt
     /// model (`backward.rs`) and of a solved map (`albedo.rs`).
     pub(super) fn warm(&mut self, scene: &Scene, own: &[Params]) -> Result<Model> {
