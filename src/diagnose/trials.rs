@@ -126,10 +126,10 @@ impl Refits<'_> {
     pub(super) fn unchanged(&mut self, model: Model) -> Result<Model> {
         match self.schedule {
             Schedule::One => self.unchanged_one(model),
-            Schedule::Set => {
-                let null = self.run_set(&model.scene, &model.own)?;
-                Ok(model.better(null))
-            }
+            Schedule::Set => match self.null(&model)? {
+                Some(null) => Ok(model.better(null)),
+                None => Ok(model),
+            },
         }
     }
 
