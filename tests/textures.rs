@@ -470,6 +470,15 @@ fn tile_scene(tile: Value, light: [f64; 3]) -> Value {
         "objects": [tile]})
 }
 
+/// The scene `s`, written into `dir`, rendered by `backend`.
+fn render_in(dir: &Path, s: &Value, backend: &str) -> Result<Image, String> {
+    let p = dir.join("scene.json");
+    std::fs::write(&p, s.to_string()).unwrap();
+    let scene = api::load_scene(&p, &[]).unwrap();
+    let r = api::renderer(backend, &RenderOptions::default()).unwrap();
+    api::render(&scene, backend, r.as_ref(), 0).map_err(|e| e.to_string())
+}
+
 /// The three maps together on a planar map, at three scales, where the
 /// colour pattern sits inside both patterned textures and is carried by
 /// both their transforms: POV-Ray draws a quad filling the view and a
@@ -534,13 +543,7 @@ fn povray_draws_a_normal_map_on_a_quad_and_a_plane_as_the_built_in_tracer_does()
         }
         tile_scene(object, [0.8, 0.6, 2.0])
     };
-    let render = |s: &Value, backend: &str| {
-        let p = d.path().join("normal.json");
-        std::fs::write(&p, s.to_string()).unwrap();
-        let scene = api::load_scene(&p, &[]).unwrap();
-        let r = api::renderer(backend, &RenderOptions::default()).unwrap();
-        api::render(&scene, backend, r.as_ref(), 0)
-    };
+    let render = |s: &Value, backend: &str| render_in(d.path(), s, backend);
     // turned and scaled (evenly) by its transform
     let moved = json!({"rotate_deg": [20, 30, 0], "scale": 0.8});
     let none = Value::Null;
@@ -575,6 +578,72 @@ fn povray_draws_a_normal_map_on_a_quad_and_a_plane_as_the_built_in_tracer_does()
         Err(e) => e.to_string(),
     };
     assert!(refused.contains("height field"), "{refused}");
+}
+
+/// POV-Ray draws a normal map made for a sphere (the height field over
+/// its longitude and latitude, `pov_bumps::sphere_heights`, read as a
+/// spherical image) as the built-in tracer does: on a sphere turned by
+/// its transform, a smaller one, and beside a colour map; within 1 % and
+/// a quarter of what the map itself changes. A flat tile's map wrapped on
+/// a sphere, which no height there has, and a normal map beside a
+/// specular map (laid by `uv_mapping`) are refused, not drawn wrong.
+#[test]
+fn povray_draws_a_normal_map_made_for_a_sphere_as_the_built_in_tracer_does() {
+    if !common::have("povray", "POV-Ray") {
+        return;
+    }
+    let d = tempfile::tempdir().unwrap();
+    // made for a sphere by scripts/make-texture.py
+    let textured = common::root().join("scenes/textured");
+    let bumps = textured.join("sphere_bumps.png");
+    let ball = |radius: f64, material: &Value, turned: bool| {
+        let mut o = json!({"name": "ball", "material": material,
+            "shape": {"type": "sphere", "center": [0.1, 0, 0], "radius": radius}});
+        if turned {
+            o["transform"] = json!({"rotate_deg": [20, 30, 0]});
+        }
+        tile_scene(o, [0.8, 0.6, 2.0])
+    };
+    let render = |s: &Value, backend: &str| render_in(d.path(), s, backend);
+    let plain = json!({"color": [0.6, 0.6, 0.6], "specular": 0.3, "shininess": 20});
+    let mut coloured = plain.clone();
+    coloured["color_map"] = json!({"file": textured.join("checker.png"), "scale": [2, 1]});
+    for (name, radius, material, turned) in [
+        ("turned", 0.9, &plain, true),
+        ("small", 0.6, &plain, false),
+        ("beside a colour map", 0.9, &coloured, true),
+    ] {
+        let mut mapped = material.clone();
+        mapped["normal_map"] = json!({"file": bumps});
+        let phong = render(&ball(radius, &mapped, turned), "phong").unwrap();
+        let pov = render(&ball(radius, &mapped, turned), "povray").unwrap();
+        let flat = render(&ball(radius, material, turned), "phong").unwrap();
+        let dev = scenefit::metric::deviation(&pov, &phong, None).average;
+        let effect = scenefit::metric::deviation(&flat, &phong, None).average;
+        eprintln!(
+            "{name}: POV-Ray {dev:.3} % from phong, the normal map's own effect {effect:.3} %"
+        );
+        assert!(dev <= 1.0, "{name}: {dev:.3} %");
+        if material == &plain {
+            assert!(
+                dev < 0.25 * effect,
+                "{name}: {dev:.3} % (the map moves {effect:.3} %)"
+            );
+        }
+    }
+    let refused = |material: Value| match render(&ball(0.9, &material, false), "povray") {
+        Ok(_) => panic!("drawn: {material}"),
+        Err(e) => e.to_string(),
+    };
+    let mut flat_tile = plain.clone();
+    flat_tile["normal_map"] = json!({"file": textured.join("bumps.png"), "scale": [6, 3]});
+    let why = refused(flat_tile);
+    assert!(why.contains("height field"), "{why}");
+    let mut beside = plain.clone();
+    beside["normal_map"] = json!({"file": bumps});
+    beside["specular_map"] = json!({"file": textured.join("stripes.png")});
+    let why = refused(beside);
+    assert!(why.contains("specular_map or shininess_map"), "{why}");
 }
 
 /// Mitsuba (`normalmap` BSDF) and Blender (Normal Map node) draw the

@@ -13,7 +13,7 @@ pub const PHONG: &[MapKind] = ALL_MAPS;
 pub const BLENDER: &[MapKind] = ALL_MAPS;
 pub const MITSUBA: &[MapKind] = ALL_MAPS;
 
-/// The maps POV-Ray draws: all four, the normal map on a plane or quad
+/// The maps POV-Ray draws: all four, the normal map on a plane, quad or sphere
 /// only (`povray_refusals`).
 pub const POVRAY: &[MapKind] = ALL_MAPS;
 
@@ -35,7 +35,8 @@ pub fn worker_refusals(scene: &Scene, mitsuba: bool) -> Vec<Refusal> {
 /// does not draw them on: a box (no per-face coordinates), glass, a
 /// specular or shininess map beside `specular2` (each is a patterned
 /// texture, and POV-Ray layers nothing over one), a normal map on other
-/// than a plane or quad.
+/// than a plane, quad or sphere (on a sphere not beside a specular or
+/// shininess map).
 pub fn povray_refusals(scene: &Scene) -> Vec<Refusal> {
     let mut out = refusals(scene, "povray", POVRAY);
     out.extend(limits(scene, true).into_iter().map(|mut r| {
@@ -44,14 +45,13 @@ pub fn povray_refusals(scene: &Scene) -> Vec<Refusal> {
     }));
     for o in &scene.objects {
         let m = &o.material;
-        let planar = matches!(
-            o.shape,
-            crate::scene::Shape::Plane { .. } | crate::scene::Shape::Quad { .. }
-        );
-        if let Some(t) = m.normal_map.as_ref().filter(|_| planar) {
-            let frame = super::pov_bumps::planar_frame(&o.shape, t.scale());
+        let lay = m
+            .normal_map
+            .as_ref()
+            .and_then(|t| super::pov_bumps::laid(&o.shape, t.scale()));
+        if let (Some(t), Some(lay)) = (&m.normal_map, lay) {
             // an unreadable file is the scene check's to report
-            let missed = frame.and_then(|f| super::pov_bumps::missed(t, f).ok().flatten());
+            let missed = super::pov_bumps::missed(t, lay).ok().flatten();
             if let Some(m) = missed {
                 let why = super::pov_bumps::not_a_height_field(m);
                 out.push(Refusal::new(
@@ -64,19 +64,26 @@ pub fn povray_refusals(scene: &Scene) -> Vec<Refusal> {
             let [a, b, c] = s.axes();
             (a - b).abs() > 1e-9 * a.abs() || (a - c).abs() > 1e-9 * a.abs()
         });
-        if m.normal_map.is_some() && planar && uneven {
+        if m.normal_map.is_some() && lay.is_some() && uneven {
             out.push(Refusal::new(
                 format!("objects.{}.transform.scale", o.name),
                 "a normal_map on an object scaled unevenly is not drawn by povray (it turns the height's gradient as a normal, the built-in tracer turns the map's frame); use phong, blender or mitsuba, or scale the shape itself",
             ));
         }
-        if m.normal_map.is_some() && !planar {
+        if m.normal_map.is_some() && lay.is_none() {
             out.push(Refusal::new(
                 format!("objects.{}.material.normal_map", o.name),
-                "a normal_map is drawn by povray on a plane or quad only (its normal is a height field's gradient, and on a sphere or mesh POV-Ray's uv_mapping tilts the normal along the world's axes, not the surface's); use phong, blender or mitsuba",
+                "a normal_map is drawn by povray on a plane, quad or sphere only (its normal is a height field's gradient, and on a mesh or box POV-Ray's uv_mapping tilts the normal along the world's axes, not the surface's); use phong, blender or mitsuba",
             ));
         }
         let patterned = m.specular_map.is_some() || m.shininess_map.is_some();
+        let sphere = matches!(o.shape, crate::scene::Shape::Sphere { .. });
+        if m.normal_map.is_some() && sphere && patterned {
+            out.push(Refusal::new(
+                format!("objects.{}.material.normal_map", o.name),
+                "a normal_map on a sphere beside a specular_map or shininess_map is not drawn by povray (their patterned texture is laid by uv_mapping, which hands the normal's pattern the surface's coordinates, not its point); use phong, blender or mitsuba",
+            ));
+        }
         if patterned && m.specular2.is_some_and(|k| k > 0.0) {
             out.push(Refusal::new(
                 format!("objects.{}.material.specular2", o.name),

@@ -21,6 +21,7 @@ pub mod pov_bumps;
 pub mod pov_maps;
 pub mod pov_sdl;
 pub mod povray;
+mod recent;
 #[cfg(test)]
 mod refusal_table;
 pub mod registry;

@@ -1,16 +1,19 @@
-//! A tangent-space normal map as POV-Ray can draw it on a planar map: a
-//! height field whose slopes are the map's. POV-Ray's `normal` takes a
-//! pattern's gradient (four samples `accuracy` apart), adds it to the
-//! surface normal and renormalises; the built-in tracer turns the map's
-//! vector (x, y, z) into x T + y B + z N (`render/phong/normal_map.rs`).
-//! The two agree when the gradient is G = (x/z) T + (y/z) B, so the
-//! height's slope along each map direction is fixed by each texel, and
-//! the height itself is their least-squares integral over the repeating
-//! tile (`heights`: a periodic Poisson equation, solved exactly by the
-//! discrete Fourier transform). A map that is a height field's (bumps, grain, a scan's
-//! relief) is drawn as given; the part of another that no height field
-//! has (a twist of the normals, a tilt of the whole tile) is lost, which
-//! `heights` reports.
+//! A tangent-space normal map as POV-Ray can draw it on a planar map or
+//! a sphere: a height field whose slopes are the map's. POV-Ray's
+//! `normal` takes a pattern's gradient (four samples `accuracy` apart),
+//! adds it to the surface normal and renormalises; the built-in tracer
+//! turns the map's vector (x, y, z) into x T + y B + z N
+//! (`render/phong/normal_map.rs`). The two agree when the gradient is
+//! G = (x/z) T + (y/z) B, so the height's slope along each map direction
+//! is fixed by each texel, and the height itself is their least-squares
+//! integral: over the repeating tile (`heights`: a periodic Poisson
+//! equation, solved exactly by the discrete Fourier transform), or over
+//! the sphere's longitude and latitude (`sphere_heights`), which POV-Ray
+//! reads as a spherical image of the point's direction. A map that is a
+//! height field's (bumps, grain, a scan's relief) is drawn as given; the
+//! part of another that no height field has (a twist of the normals, a
+//! tilt of the whole tile, a flat tile's map wrapped on a sphere, whose
+//! east steps shrink towards the poles) is lost, which the solve reports.
 //!
 //! The height is laid out `FINE` times finer than the map: POV-Ray's
 //! bilinear pattern has a slope that is constant across each cell, where
@@ -18,12 +21,13 @@
 //! `MAX_SIDE` texels a side, which bounds the solve's memory (about 100
 //! bytes a texel: 100 MB for 1024 x 1024).
 
+use super::recent::Recent;
 use crate::math::V3;
 use crate::scene::texture::{self, MapKind, Texels, TextureRef};
 use crate::scene::Shape;
 use rustfft::num_complex::Complex;
 use rustfft::FftPlanner;
-use std::sync::{Arc, Mutex};
+use std::sync::Arc;
 
 /// The height field is laid out this many times finer than the map, at
 /// most `MAX_SIDE` texels a side.
@@ -57,50 +61,78 @@ pub fn refused(h: &Heights) -> bool {
 /// height field's on its surface (the caller names the field).
 pub fn not_a_height_field(missed: f64) -> String {
     format!(
-        "{:.0} % of its slopes are not a height field's on this surface (at most {:.0} %: a map stretched unevenly by `scale` or the shape, or twisted), and POV-Ray draws a normal map as a height's gradient; use phong, blender or mitsuba, or a map made for this scale",
+        "{:.0} % of its slopes are not a height field's on this surface (at most {:.0} %: a map stretched unevenly by `scale` or the shape, a flat tile's map on a sphere, or twisted), and POV-Ray draws a normal map as a height's gradient; use phong, blender or mitsuba, or a map made for this scale",
         100.0 * missed,
         100.0 * MAX_MISSED
     )
 }
 
-/// The height field of the normal map `t` (read as the scene reads it,
-/// its `range` applied) on `frame`. The last few are kept: the refusal
-/// check (`maps::povray_refusals`) asks on every render of a fit, and
-/// the map's writer (`PovMaps`) once a session; each is solved once.
-/// At most `KEPT` x 8 MB (`MAX_SIDE` squared values).
-pub fn solved(t: &TextureRef, frame: Frame) -> Result<Arc<Heights>, String> {
-    type Key = (String, [u64; 2], [u64; 4]);
-    static SEEN: Mutex<Vec<(Key, Arc<Heights>)>> = Mutex::new(Vec::new());
-    const KEPT: usize = 4;
-    let range = t.range();
-    let key = (
-        t.file().to_string(),
-        range.map(f64::to_bits),
-        frame.map(f64::to_bits),
-    );
-    if let Some((_, h)) = SEEN
-        .lock()
-        .expect("heights")
-        .iter()
-        .find(|(k, _)| *k == key)
-    {
-        return Ok(h.clone());
-    }
-    let texels = texture::get(std::path::Path::new(t.file()), t.encoding(MapKind::Normal))?;
-    let h = Arc::new(heights(&texels, range, frame));
-    let mut seen = SEEN.lock().expect("heights");
-    if seen.len() >= KEPT {
-        seen.remove(0);
-    }
-    seen.push((key, h.clone()));
-    Ok(h)
+/// How a normal map lies on its shape: a planar map's frame, or a
+/// sphere's radius and the map's `scale` (the map repeated that many
+/// times around and up the sphere's longitude and latitude).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Lay {
+    Planar(Frame),
+    Sphere { radius: f64, scale: [f64; 2] },
 }
 
-/// The share of its slopes the height field of normal map `t` on `frame`
-/// misses when it is refused (`refused`), else None.
-pub fn missed(t: &TextureRef, frame: Frame) -> Result<Option<f64>, String> {
-    let h = solved(t, frame)?;
-    Ok(refused(&h).then_some(h.missed))
+impl Lay {
+    /// The numbers that decide a height field, as bits (a cache key).
+    pub fn bits(&self) -> [u64; 5] {
+        let b = f64::to_bits;
+        match *self {
+            Lay::Planar([a, c, d, e]) => [0, b(a), b(c), b(d), b(e)],
+            Lay::Sphere { radius, scale } => [1, b(radius), b(scale[0]), b(scale[1]), 0],
+        }
+    }
+}
+
+/// How a map at `scale` lies on `shape` for its height field: a plane,
+/// a quad or a sphere; None on a box or a mesh (refused).
+pub fn laid(shape: &Shape, scale: [f64; 2]) -> Option<Lay> {
+    match *shape {
+        Shape::Sphere { radius, .. } => Some(Lay::Sphere { radius, scale }),
+        _ => planar_frame(shape, scale).map(Lay::Planar),
+    }
+}
+
+/// What a normal map's height field is kept by: its file, `range` and
+/// lay.
+type Key = (String, [u64; 2], [u64; 5]);
+
+fn key(t: &TextureRef, lay: Lay) -> Key {
+    (
+        t.file().to_string(),
+        t.range().map(f64::to_bits),
+        lay.bits(),
+    )
+}
+
+/// The height field of the normal map `t` (read as the scene reads it,
+/// its `range` applied) as it lies (`lay`). The last few are kept for
+/// the map's writer (`PovMaps`) and the refusal check; each is solved
+/// once. At most 4 x 8 MB (`MAX_SIDE` squared values).
+pub fn solved(t: &TextureRef, lay: Lay) -> Result<Arc<Heights>, String> {
+    static FIELDS: Recent<Key, Arc<Heights>> = Recent::new(4);
+    FIELDS.get_or(key(t, lay), || {
+        let texels = texture::get(std::path::Path::new(t.file()), t.encoding(MapKind::Normal))?;
+        Ok(Arc::new(match lay {
+            Lay::Planar(frame) => heights(&texels, t.range(), frame),
+            Lay::Sphere { radius, scale } => sphere_heights(&texels, t.range(), radius, scale),
+        }))
+    })
+}
+
+/// The share of its slopes the height field of normal map `t` as it
+/// lies misses when it is refused (`refused`), else None. The refusal check
+/// (`maps::povray_refusals`) asks for every map on every render of a
+/// fit: the answers are kept for more maps (16) than the fields are, so
+/// a scene with many maps does not solve each again on each render.
+pub fn missed(t: &TextureRef, lay: Lay) -> Result<Option<f64>, String> {
+    static SHARES: Recent<Key, Option<f64>> = Recent::new(16);
+    SHARES.get_or(key(t, lay), || {
+        solved(t, lay).map(|h| refused(&h).then_some(h.missed))
+    })
 }
 
 /// A planar map's frame (None on a sphere, box or mesh): from the world
@@ -162,6 +194,30 @@ pub struct Heights {
     pub slope: f64,
 }
 
+impl Heights {
+    /// A solved field, from its weighed squared misfit and slopes
+    /// (`misfit`, `total`) and its mean squared slope.
+    fn of(
+        width: u32,
+        height: u32,
+        values: Vec<f64>,
+        (misfit, total): (f64, f64),
+        slope2: f64,
+    ) -> Heights {
+        Heights {
+            width,
+            height,
+            values,
+            missed: if total > 0.0 {
+                (misfit / total).sqrt()
+            } else {
+                0.0
+            },
+            slope: slope2.sqrt(),
+        }
+    }
+}
+
 /// The height field whose slopes best match the normal map `texels`,
 /// each value read as `lo + v (hi - lo)` for `range` [lo, hi] as the
 /// built-in tracer reads it, in `frame`, wrapped as the map repeats.
@@ -177,12 +233,7 @@ pub fn heights(texels: &Texels, range: [f64; 2], frame: Frame) -> Heights {
     // Slopes along +s and along +t (per unit of the map's coordinates) at
     // (s, t), from the bilinear lookup as the built-in tracer reads it.
     let slope = |s: f64, t: f64| {
-        let [lo, hi] = range;
-        let [r, g, b] = texels
-            .sample(s, t)
-            .map(|c| 2.0 * (lo + c as f64 * (hi - lo)) - 1.0);
-        let z = b.max(MIN_Z);
-        let (gx, gy) = (r / z, g / z);
+        let (gx, gy) = gradient(texels, range, s, t);
         let [ts, bs, tt, bt] = frame;
         (gx * ts + gy * bs, gx * tt + gy * bt, gx * gx + gy * gy)
     };
@@ -229,17 +280,140 @@ pub fn heights(texels: &Texels, range: [f64; 2], frame: Frame) -> Heights {
             total += dx[at(i, r)].powi(2) + beta * dy[at(i, r)].powi(2);
         }
     }
-    Heights {
-        width: w,
-        height: h,
-        values,
-        missed: if total > 0.0 {
-            (misfit / total).sqrt()
-        } else {
-            0.0
-        },
-        slope: (slope2 / (wn * hn) as f64).sqrt(),
+    Heights::of(w, h, values, (misfit, total), slope2 / (wn * hn) as f64)
+}
+
+/// The built-in tracer's gradient G = (x/z, y/z) in its tangent frame
+/// (T, B) for the normal map `texels` at (s, t), `range` applied.
+fn gradient(texels: &Texels, [lo, hi]: [f64; 2], s: f64, t: f64) -> (f64, f64) {
+    let [r, g, b] = texels
+        .sample(s, t)
+        .map(|c| 2.0 * (lo + c as f64 * (hi - lo)) - 1.0);
+    let z = b.max(MIN_Z);
+    (r / z, g / z)
+}
+
+/// The height field of the normal map `texels` on a sphere of `radius`,
+/// the map repeated `scale` times around and up it, laid out over the
+/// whole sphere by longitude (u, columns, wrapping) and latitude (v, rows
+/// from the north pole down) as POV-Ray's spherical `map_type 1` reads
+/// an image. The built-in tracer's frame there is T east (|dP/du| =
+/// 2 pi r cos(lat)) and B north (|dP/dv| = pi r). Each difference is
+/// weighed as the slope it stands for over the area it covers, so a row
+/// near a pole, whose steps are short and its area small, neither
+/// dominates nor vanishes; the solve is exact (`sphere_poisson`).
+pub fn sphere_heights(texels: &Texels, range: [f64; 2], radius: f64, scale: [f64; 2]) -> Heights {
+    let reps = scale.map(|x| x.abs().ceil().max(1.0) as u32);
+    let (tw, th) = (texels.width * reps[0], texels.height * reps[1]);
+    let f = FINE.min((MAX_SIDE / tw.max(th).max(1)).max(1));
+    let (w, h) = ((tw * f).min(MAX_SIDE), (th * f).clamp(2, MAX_SIDE));
+    let (wn, hn) = (w as usize, h as usize);
+    let pi = std::f64::consts::PI;
+    let cos_lat = |v: f64| (pi * (v - 0.5)).cos().max(0.0);
+    let g = |u: f64, v: f64| gradient(texels, range, u * scale[0], v * scale[1]);
+    // Row r's centre is at v = 1 - (r + 0.5) / h; the edge below it at
+    // 1 - (r + 1) / h. Weights are those of slopes over area, in units
+    // of a latitude step's: along a row (w / 2h)^2 / cos, down cos.
+    let v_row = |r: usize| 1.0 - (r as f64 + 0.5) / h as f64;
+    let v_edge = |r: usize| 1.0 - (r as f64 + 1.0) / h as f64;
+    let ratio = (w as f64 / (2.0 * h as f64)).powi(2);
+    let ws: Vec<f64> = (0..hn).map(|r| ratio / cos_lat(v_row(r))).collect();
+    // The edges below the last row and above the first are the poles:
+    // no difference crosses them.
+    let wt: Vec<f64> = (0..hn)
+        .map(|r| match r + 1 < hn {
+            true => cos_lat(v_edge(r)),
+            false => 0.0,
+        })
+        .collect();
+    let (mut dx, mut dy) = (vec![0.0; wn * hn], vec![0.0; wn * hn]);
+    let (mut slope2, mut area) = (0.0, 0.0);
+    for r in 0..hn {
+        for i in 0..wn {
+            let u = (i as f64 + 0.5) / w as f64;
+            let (v, ve) = (v_row(r), v_edge(r));
+            // Heights in world length: east per column 2 pi r cos / w,
+            // north per row pi r / h; down a row is south.
+            let east = 2.0 * pi * radius * cos_lat(v) / w as f64;
+            dx[r * wn + i] = -g(u + 0.5 / w as f64, v).0 * east;
+            dy[r * wn + i] = g(u, ve).1 * pi * radius / h as f64;
+            let (gx, gy) = g(u, v);
+            slope2 += cos_lat(v) * (gx * gx + gy * gy);
+            area += cos_lat(v);
+        }
     }
+    let at = |i: usize, r: usize| r * wn + i;
+    let mut rhs = vec![0.0; wn * hn];
+    for r in 0..hn {
+        for i in 0..wn {
+            let left = (i + wn - 1) % wn;
+            let mut b = ws[r] * (dx[at(left, r)] - dx[at(i, r)]) - wt[r] * dy[at(i, r)];
+            if r > 0 {
+                b += wt[r - 1] * dy[at(i, r - 1)];
+            }
+            rhs[at(i, r)] = b;
+        }
+    }
+    let values = sphere_poisson(&rhs, wn, &ws, &wt);
+    let (mut misfit, mut total) = (0.0, 0.0);
+    for r in 0..hn {
+        for i in 0..wn {
+            let ex = values[at((i + 1) % wn, r)] - values[at(i, r)] - dx[at(i, r)];
+            misfit += ws[r] * ex * ex;
+            total += ws[r] * dx[at(i, r)].powi(2);
+            if r + 1 < hn {
+                let ey = values[at(i, r + 1)] - values[at(i, r)] - dy[at(i, r)];
+                misfit += wt[r] * ey * ey;
+                total += wt[r] * dy[at(i, r)].powi(2);
+            }
+        }
+    }
+    Heights::of(w, h, values, (misfit, total), slope2 / area.max(1e-12))
+}
+
+/// Solves the sphere's normal equations for heights x on `w` columns
+/// that wrap and `ws.len()` rows that do not: per row r,
+/// ws[r] (2 x - left - right) + wt[r-1] (x - up) + wt[r] (x - down) = b.
+/// The rows' weights do not change along a row, so the discrete Fourier
+/// transform along the rows makes each column's frequency its own
+/// tridiagonal system down the rows, solved exactly (Thomas); the
+/// constant is taken with mean 0.
+fn sphere_poisson(b: &[f64], w: usize, ws: &[f64], wt: &[f64]) -> Vec<f64> {
+    let h = ws.len();
+    let mut planner = FftPlanner::<f64>::new();
+    let mut rows: Vec<Complex<f64>> = b.iter().map(|&x| Complex::new(x, 0.0)).collect();
+    planner.plan_fft_forward(w).process(&mut rows);
+    let tau = std::f64::consts::TAU;
+    // A constant is free at frequency 0: a nudge far below every weight
+    // fixes it without moving the rest.
+    let nudge = 1e-9 * ws.iter().chain(wt).fold(0.0f64, |m, &x| m.max(x));
+    let (mut c, mut d) = (vec![0.0; h], vec![Complex::new(0.0, 0.0); h]);
+    for k in 0..w {
+        let lambda = 2.0 - 2.0 * (tau * k as f64 / w as f64).cos();
+        // Forward sweep, leaving x_r = d_r - c_r x_{r+1}.
+        for r in 0..h {
+            let up = if r > 0 { wt[r - 1] } else { 0.0 };
+            let diag = ws[r] * lambda + up + wt[r] + if k == 0 { nudge } else { 0.0 };
+            let (c_up, d_up) = match r {
+                0 => (0.0, Complex::new(0.0, 0.0)),
+                _ => (c[r - 1], d[r - 1]),
+            };
+            let denom = diag + up * c_up;
+            c[r] = -wt[r] / denom;
+            d[r] = (rows[r * w + k] + d_up * up) / denom;
+        }
+        let mut next = Complex::new(0.0, 0.0);
+        for r in (0..h).rev() {
+            let x = d[r] - next * c[r];
+            rows[r * w + k] = x;
+            next = x;
+        }
+    }
+    planner.plan_fft_inverse(w).process(&mut rows);
+    let mut values: Vec<f64> = rows.iter().map(|c| c.re / w as f64).collect();
+    let mean = values.iter().sum::<f64>() / values.len() as f64;
+    values.iter_mut().for_each(|v| *v -= mean);
+    values
 }
 
 /// Solves L x = `b` on a `w` x `h` grid that wraps, L the five-point
@@ -445,5 +619,62 @@ mod tests {
                 h.missed
             );
         }
+    }
+
+    /// The normal map of a known height on a sphere, H(d) = a (d.x +
+    /// d.y d.z) over the direction d from the centre (smooth through the
+    /// poles), laid by longitude and latitude as the built-in tracer
+    /// lays it: the sphere's solve gives H back, poles and seam included.
+    #[test]
+    fn a_height_on_a_sphere_is_given_back() {
+        let (n, a, radius) = (64u32, 0.05, 2.0);
+        let pi = std::f64::consts::PI;
+        let dir = |u: f64, v: f64| {
+            let (lon, lat) = (2.0 * pi * u, pi * (v - 0.5));
+            V3::new(lat.cos() * lon.cos(), lat.sin(), -lat.cos() * lon.sin())
+        };
+        let truth = |d: V3| a * (d.x + d.y * d.z);
+        let mut values = Vec::new();
+        for j in 0..n / 2 {
+            for i in 0..n {
+                let (u, v) = (
+                    (i as f64 + 0.5) / n as f64,
+                    1.0 - (j as f64 + 0.5) / (n / 2) as f64,
+                );
+                let d = dir(u, v);
+                let g = V3::new(a, a * d.z, a * d.y);
+                let grad = (g - d * g.dot(d)) / radius;
+                let east = V3::new(d.z, 0.0, -d.x).normalized();
+                let north = d.cross(east);
+                let (ge, gn) = (grad.dot(east), grad.dot(north));
+                let l = (ge * ge + gn * gn + 1.0).sqrt();
+                for c in [-ge / l, -gn / l, 1.0 / l] {
+                    values.push(((c + 1.0) / 2.0) as f32);
+                }
+            }
+        }
+        let texels = Texels {
+            width: n,
+            height: n / 2,
+            values,
+        };
+        let h = sphere_heights(&texels, [0.0, 1.0], radius, [1.0, 1.0]);
+        assert!(h.missed < 0.05, "missed {}", h.missed);
+        let (w, rows) = (h.width as usize, h.height as usize);
+        let want: Vec<f64> = (0..rows * w)
+            .map(|k| {
+                let (i, r) = (k % w, k / w);
+                truth(dir(
+                    (i as f64 + 0.5) / w as f64,
+                    1.0 - (r as f64 + 0.5) / rows as f64,
+                ))
+            })
+            .collect();
+        let mean = want.iter().sum::<f64>() / want.len() as f64;
+        let worst = want
+            .iter()
+            .zip(&h.values)
+            .fold(0.0f64, |m, (t, v)| m.max((t - mean - v).abs()));
+        assert!(worst < 0.05 * a, "worst {worst} of amplitude {a}");
     }
 }

@@ -6,7 +6,7 @@
 //! bilinear) reads scenefit's linear values to 1/65535. The SDL names
 //! only these files (`m0r.png`, ...), never a path from the scene.
 
-use super::pov_bumps::{self, Frame};
+use super::pov_bumps::{self, Lay};
 use crate::scene::texture::{self, Encoding, MapKind, TextureRef};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -44,10 +44,10 @@ pub fn levels(values: &[f64]) -> Vec<f64> {
 }
 
 /// (file, encoding, range bits, channels, whether its `levels` are
-/// wanted, a normal map's frame bits): what decides a written map. The
+/// wanted, a normal map's lay as bits): what decides a written map. The
 /// same file may be a specular map and a shininess map of one scene, and
 /// a normal map's height depends on the surface it lies on.
-type Key = (String, Encoding, [u64; 2], usize, bool, [u64; 4]);
+type Key = (String, Encoding, [u64; 2], usize, bool, [u64; 5]);
 
 /// The maps written into one run directory.
 pub struct PovMaps {
@@ -66,13 +66,13 @@ impl PovMaps {
     /// The files POV-Ray reads for map `t` of kind `kind`, written on
     /// first use in this session.
     /// A normal map (`kind` Normal) is written as the height field of its
-    /// slopes on the planar map `frame` (`pov_bumps`), `scale` its range
-    /// in world length.
+    /// slopes as it lies (`lay`: `pov_bumps`), `scale` its range in
+    /// world length.
     pub fn get(
         &self,
         t: &TextureRef,
         kind: MapKind,
-        frame: Option<Frame>,
+        lay: Option<Lay>,
     ) -> Result<Arc<Channels>, String> {
         let channels = if kind == MapKind::Color { 3 } else { 1 };
         let [lo, hi] = t.range();
@@ -84,16 +84,16 @@ impl PovMaps {
             [lo.to_bits(), hi.to_bits()],
             channels,
             shininess,
-            frame.unwrap_or_default().map(f64::to_bits),
+            lay.map_or([0; 5], |l| l.bits()),
         );
         let mut written = self.written.lock().expect("pov maps");
         if let Some(c) = written.get(&key) {
             return Ok(c.clone());
         }
         if kind == MapKind::Normal {
-            let frame = frame.ok_or("normal_map: drawn by POV-Ray on a plane or quad only")?;
+            let lay = lay.ok_or("normal_map: drawn by POV-Ray on a plane, quad or sphere only")?;
             let name = format!("m{}h.png", written.len());
-            let c = Arc::new(self.write_heights(t, frame, &name)?);
+            let c = Arc::new(self.write_heights(t, lay, &name)?);
             written.insert(key, c.clone());
             return Ok(c);
         }
@@ -138,12 +138,11 @@ impl PovMaps {
         Ok(c)
     }
 
-    /// The height field of the normal map `t` on `frame`, written as one
+    /// The height field of the normal map `t` as it lies, written as one
     /// 16-bit grey PNG spanning [0, 1] (`scale`: its range). The refusal
     /// is the scene check's (`maps::povray_refusals`); this is its guard.
-    fn write_heights(&self, t: &TextureRef, frame: Frame, name: &str) -> Result<Channels, String> {
-        let h =
-            pov_bumps::solved(t, frame).map_err(|e| format!("normal_map: {}: {e}", t.file()))?;
+    fn write_heights(&self, t: &TextureRef, lay: Lay, name: &str) -> Result<Channels, String> {
+        let h = pov_bumps::solved(t, lay).map_err(|e| format!("normal_map: {}: {e}", t.file()))?;
         if pov_bumps::refused(&h) {
             let why = pov_bumps::not_a_height_field(h.missed);
             return Err(format!("normal_map: {why}"));

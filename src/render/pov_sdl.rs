@@ -53,7 +53,7 @@
 //!   on glass, a specular or shininess map beside `specular2`.
 
 use super::backend::Refusal;
-use super::pov_bumps::{self, Frame};
+use super::pov_bumps::{self, Lay};
 use super::pov_maps::Channels;
 use crate::math::V3;
 use crate::scene::pinhole::Pinhole;
@@ -178,7 +178,7 @@ fn fade(p: f64) -> (f64, String) {
 
 /// Where the SDL finds a map's files (`pov_maps::PovMaps::get`).
 pub type MapSource<'a> =
-    &'a dyn Fn(&TextureRef, MapKind, Option<Frame>) -> Result<Arc<Channels>, String>;
+    &'a dyn Fn(&TextureRef, MapKind, Option<Lay>) -> Result<Arc<Channels>, String>;
 
 /// The scene file POV-Ray renders, for a scene without texture maps (a
 /// map needs files in a run directory: `sdl_with`).
@@ -608,16 +608,16 @@ fn placed(
     t: &TextureRef,
     outer: Option<&TextureRef>,
 ) -> Result<(Arc<Channels>, String, String), String> {
-    let frame = match k {
-        MapKind::Normal => Some(pov_bumps::planar_frame(&o.shape, t.scale()).ok_or_else(|| {
+    let lay = match k {
+        MapKind::Normal => Some(pov_bumps::laid(&o.shape, t.scale()).ok_or_else(|| {
             format!(
-                "objects.{}.material.normal_map: drawn by POV-Ray on a plane or quad only",
+                "objects.{}.material.normal_map: drawn by POV-Ray on a plane, quad or sphere only",
                 o.name
             )
         })?),
         _ => None,
     };
-    let ch = maps(t, k, frame).map_err(|e| format!("objects.{}.material.{e}", o.name))?;
+    let ch = maps(t, k, lay).map_err(|e| format!("objects.{}.material.{e}", o.name))?;
     let (pre, mut post) = mapping(&o.shape, t.scale()).ok_or_else(|| {
         format!(
             "objects.{}.material.{}: not drawn on this shape by POV-Ray",
@@ -677,6 +677,27 @@ fn mapped_normal(
     let (ch, pre, post) = placed(o, maps, MapKind::Normal, t, outer)?;
     if ch.scale <= 0.0 {
         return Ok(String::new());
+    }
+    if let Shape::Sphere { center, radius } = o.shape {
+        if outer.is_some() {
+            // the scene check's refusal (`maps::povray_refusals`); a guard
+            return Err(format!(
+                "objects.{}.material.normal_map: on a sphere beside a specular or shininess map, not drawn by POV-Ray",
+                o.name
+            ));
+        }
+        // A sphere's heights are laid over its longitude and latitude as
+        // POV-Ray's spherical image map reads a direction from the
+        // origin (`pov_bumps::sphere_heights`): a pattern of the point in
+        // space whose gradient lies in the surface. `uv_mapping` would
+        // tilt the normal along the world's axes instead.
+        return Ok(format!(
+            " normal {{ image_pattern {{ png \"{}\" gamma 1.0 map_type 1 interpolate 2 }} bump_size {} accuracy {} translate {} }}",
+            ch.files[0],
+            num(ch.scale / BUMP_GAIN),
+            num(BUMP_ACCURACY * radius),
+            vec(pov(center))
+        ));
     }
     Ok(format!(
         " normal {{ {pre}{} bump_size {} accuracy {}{post} }}",

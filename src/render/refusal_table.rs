@@ -61,10 +61,17 @@ fn scene_for(field: &str) -> Scene {
             s.objects[0].transform =
                 serde_json::from_value(serde_json::json!({"scale": [1.0, 2.0, 1.0]})).unwrap();
         }
-        "`material.normal_map` on a `sphere` or `mesh`" => {
-            m.normal_map = Some(TextureRef::File("t.png".into()))
+        "`material.normal_map` on a `mesh`" => {
+            m.normal_map = Some(TextureRef::File("t.png".into()));
+            s.objects[0].shape = crate::scene::Shape::Mesh {
+                file: "m.ply".into(),
+            };
         }
-        "a `normal_map` on a `plane` or `quad` more than 5 % of whose slopes are not a height field's there" => {
+        "a `normal_map` on a `sphere` beside a `specular_map` or `shininess_map`" => {
+            m.normal_map = Some(TextureRef::File("t.png".into()));
+            m.specular_map = Some(TextureRef::File("t.png".into()));
+        }
+        "a `normal_map` on a `plane`, `quad` or `sphere` more than 5 % of whose slopes are not a height field's there" => {
             m.normal_map = Some(TextureRef::File(twisted_normal_map()));
             s.objects[0].shape = serde_json::from_value(
                 serde_json::json!({"type": "quad", "corner": [0.0, 0.0, 0.0], "edge_u": [1.0, 0.0, 0.0], "edge_v": [0.0, 1.0, 0.0]}),
