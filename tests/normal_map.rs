@@ -171,10 +171,10 @@ fn a_degenerate_uv_triangle_falls_back_to_its_own_frame() {
     }
 }
 
-/// POV-Ray refuses a normal map on a sphere, and on a quad one that no
-/// height field has (one tilt everywhere: a height that repeats cannot
-/// slope one way throughout), naming the field, before it starts; a flat
-/// map on a quad it draws.
+/// POV-Ray refuses a normal map that no height field has on its surface
+/// (one tilt everywhere: a height that repeats on a quad, or goes round
+/// a sphere, cannot slope one way throughout), naming the field, before
+/// it starts; a flat map on a quad and on a sphere it draws.
 #[test]
 fn povray_refuses_a_normal_map_it_cannot_draw_naming_the_field() {
     let d = tempfile::tempdir().unwrap();
@@ -194,7 +194,7 @@ fn povray_refuses_a_normal_map_it_cannot_draw_naming_the_field() {
     };
     let tile = |map: &str| quad(json!({"color": [0.9, 0.9, 0.9], "normal_map": map}), None);
     for (object, field) in [
-        (ball("flat.png"), "objects.ball.material.normal_map"),
+        (ball("tilt.png"), "objects.ball.material.normal_map"),
         (tile("tilt.png"), "objects.tile.material.normal_map"),
     ] {
         scene(d.path(), object, [0.0, 0.0, 1.0]);
@@ -205,10 +205,13 @@ fn povray_refuses_a_normal_map_it_cannot_draw_naming_the_field() {
         assert!(!d.path().join("o.png").exists());
     }
     if backends::have("povray", "POV-Ray") {
-        scene(d.path(), tile("flat.png"), [0.0, 0.0, 1.0]);
-        let o = scenefit(d.path(), &povray);
-        assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
-        assert!(d.path().join("o.png").exists());
+        for object in [tile("flat.png"), ball("flat.png")] {
+            scene(d.path(), object, [0.0, 0.0, 1.0]);
+            let o = scenefit(d.path(), &povray);
+            assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+            assert!(d.path().join("o.png").exists());
+            std::fs::remove_file(d.path().join("o.png")).unwrap();
+        }
     }
 }
 
