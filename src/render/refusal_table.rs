@@ -26,6 +26,15 @@ fn rows() -> Vec<(String, String)> {
         .collect()
 }
 
+/// The quad of side 1 at the origin, facing +z.
+fn unit_quad() -> crate::scene::Shape {
+    serde_json::from_value(
+        serde_json::json!({"type": "quad", "corner": [0.0, 0.0, 0.0],
+        "edge_u": [1.0, 0.0, 0.0], "edge_v": [0.0, 1.0, 0.0]}),
+    )
+    .unwrap()
+}
+
 /// A scene exercising the row whose field column starts with `field`.
 fn scene_for(field: &str) -> Scene {
     let mut s = ball(r#""color": [0.5, 0.5, 0.5]"#, "");
@@ -54,10 +63,7 @@ fn scene_for(field: &str) -> Scene {
         }
         "a `normal_map` on an object whose `transform.scale` differs between axes" => {
             m.normal_map = Some(TextureRef::File("t.png".into()));
-            s.objects[0].shape = serde_json::from_value(
-                serde_json::json!({"type": "quad", "corner": [0.0, 0.0, 0.0], "edge_u": [1.0, 0.0, 0.0], "edge_v": [0.0, 1.0, 0.0]}),
-            )
-            .unwrap();
+            s.objects[0].shape = unit_quad();
             s.objects[0].transform =
                 serde_json::from_value(serde_json::json!({"scale": [1.0, 2.0, 1.0]})).unwrap();
         }
@@ -73,10 +79,7 @@ fn scene_for(field: &str) -> Scene {
         }
         "a `normal_map` on a `plane`, `quad` or `sphere` more than 5 % of whose slopes are not a height field's there" => {
             m.normal_map = Some(TextureRef::File(twisted_normal_map()));
-            s.objects[0].shape = serde_json::from_value(
-                serde_json::json!({"type": "quad", "corner": [0.0, 0.0, 0.0], "edge_u": [1.0, 0.0, 0.0], "edge_v": [0.0, 1.0, 0.0]}),
-            )
-            .unwrap();
+            s.objects[0].shape = unit_quad();
         }
         "a texture map on a `box`" => {
             m.color_map = Some(TextureRef::File("t.png".into()));
