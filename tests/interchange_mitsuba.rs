@@ -70,7 +70,7 @@ fn deviation(a: &Path, b: &Path) -> f64 {
 }
 
 /// A scene with every kind of thing the export writes: a sphere, a
-/// textured quad, a box, a posed mesh, a point and a directional light.
+/// textured quad, a textured box, a posed mesh, a point and a directional light.
 fn scene_json() -> String {
     let root = common::root();
     let mesh = root.join("scenes/mesh_blob.ply");
@@ -86,7 +86,7 @@ fn scene_json() -> String {
     {{"name": "ball", "shape": {{"type": "sphere", "center": [-1.1, 0.5, 0], "radius": 0.5}},
       "material": {{"color": [0.8, 0.3, 0.2], "specular": 0.4, "shininess": 30}}}},
     {{"name": "crate", "shape": {{"type": "box", "min": [0.6, 0, -0.4], "max": [1.4, 0.8, 0.4]}},
-      "material": {{"color": [0.3, 0.5, 0.8]}}, "transform": {{"rotate_deg": [0, -20, 0]}}}},
+      "material": {{"color": [0.3, 0.5, 0.8], "color_map": {{"file": {tex:?}, "scale": [2, 1]}}}}, "transform": {{"rotate_deg": [0, -20, 0]}}}},
     {{"name": "blob", "shape": {{"type": "mesh", "file": {mesh:?}}},
       "transform": {{"scale": [1.1, 0.9, 1.0], "rotate_deg": [0, 25, 5], "translate": [0.1, 0, 0.2]}},
       "material": {{"color": [0.7, 0.7, 0.3], "specular": 0.2, "shininess": 20, "reflection": 0.1}}}},
@@ -120,6 +120,7 @@ fn an_exported_scene_renders_in_mitsuba_as_the_backend_draws_it() {
         "scene.xml",
         "scenefit_plugins.py",
         "meshes/blob.ply",
+        "meshes/crate.ply",
         "textures/floor_color_map.exr",
     ] {
         assert!(d.join("out").join(f).is_file(), "out/{f} written");

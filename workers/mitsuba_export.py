@@ -36,7 +36,7 @@ import sys
 from xml.sax.saxutils import quoteattr
 
 import mitsuba_worker
-from scene_common import SceneError
+from scene_common import SceneError, cross
 
 # What each key of build_dict's description is in XML: the tag of a nested
 # plug-in by its key (objects O*, lights L* by their own type below).
@@ -129,6 +129,41 @@ class Exporter(mitsuba_worker.MitsubaBackend):
         return d
 
 
+# The unit cube's faces as scenefit lays a box's (src/scene/texture/uv.rs,
+# `box_faces`): corner, edge along u, edge along v; each face the whole
+# image, edge_u x edge_v outward.
+UNIT_CUBE_FACES = (
+    ((-1, -1, -1), (0, 0, 2), (0, 2, 0)),   # -x
+    ((1, -1, 1), (0, 0, -2), (0, 2, 0)),    # +x
+    ((-1, -1, -1), (2, 0, 0), (0, 0, 2)),   # -y
+    ((-1, 1, 1), (2, 0, 0), (0, 0, -2)),    # +y
+    ((1, -1, -1), (-2, 0, 0), (0, 2, 0)),   # -z
+    ((-1, -1, 1), (2, 0, 0), (0, 2, 0)),    # +z
+)
+
+
+def write_unit_cube(path):
+    """The cube [-1, 1]^3 as an ASCII PLY: four vertices a face with its
+    outward normal and scenefit's (u, v), two triangles a face."""
+    verts, tris = [], []
+    for c, eu, ev in UNIT_CUBE_FACES:
+        n = [x / 4.0 for x in cross(eu, ev)]
+        base = len(verts)
+        for s, t in ((0, 0), (1, 0), (1, 1), (0, 1)):
+            p = [c[k] + s * eu[k] + t * ev[k] for k in range(3)]
+            verts.append(p + n + [s, t])
+        tris += [(base, base + 1, base + 2), (base, base + 2, base + 3)]
+    with open(path, "w") as f:
+        f.write("ply\nformat ascii 1.0\nelement vertex %d\n" % len(verts))
+        for name in ("x", "y", "z", "nx", "ny", "nz", "u", "v"):
+            f.write("property float %s\n" % name)
+        f.write("element face %d\nproperty list uchar int vertex_indices\nend_header\n" % len(tris))
+        for v in verts:
+            f.write(" ".join("%g" % x for x in v) + "\n")
+        for t in tris:
+            f.write("3 %d %d %d\n" % t)
+
+
 def describe_for_xml(ex, plan, names):
     """build_dict's description, with each object's and light's key its
     scenefit name (the XML id), meshes copied beside the XML and placed,
@@ -162,6 +197,13 @@ def describe_for_xml(ex, plan, names):
                 if o["transform"] is not None:
                     place = mitsuba_worker.matmul4(o["transform"], place)
                 value["to_world"] = ex.T([list(r) for r in place])
+                if o["mapped"]:
+                    # an XML cube keeps Mitsuba's own coordinates: a mapped
+                    # box is a unit cube mesh carrying scenefit's per face
+                    rel = os.path.join("meshes", safe(o["name"]) + ".ply")
+                    os.makedirs(os.path.join(ex.out, "meshes"), exist_ok=True)
+                    write_unit_cube(os.path.join(ex.out, rel))
+                    value["type"], value["filename"] = "ply", rel
             out[(names["O"][int(key[1:])], key)] = value
         elif key.startswith("L") and key[1:].isdigit():
             out[(names["L"][int(key[1:])], key)] = value

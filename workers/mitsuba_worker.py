@@ -82,7 +82,9 @@ objects
              scenefit read (its vertex normals when it has them).
   quad    -> ``rectangle`` with to_world columns edge_u/2, edge_v/2,
              normalize(edge_u x edge_v), origin corner + (edge_u+edge_v)/2.
-  box     -> ``cube`` mesh whose vertices are set to center + half_size * unit cube.
+  box     -> ``cube`` mesh whose vertices are set to center + half_size * unit cube;
+             with maps, its texture coordinates set to scenefit's per face
+             (``box_texcoords``: each face the whole image, as uv.rs lays it).
   transform (an object's placement, scene_common.transform): its matrix times
              the shape's to_world; for a box, applied to each vertex; for a
              mesh, to the file's vertices (normals by the inverse transpose),
@@ -106,7 +108,7 @@ materials (d = diffuse, c = color, ks = specular, n = shininess, kr = reflection
                       (a mapped sphere's to_world takes local z to +y, a
                       mapped plane's axes are scenefit's e_u, e_v, an OBJ's v
                       is flipped back) and flips v for the bitmap's rows.
-                      A map on a box or on glass is refused (render/maps.rs).
+                      A map on glass is refused (render/maps.rs).
   normal_map       -> a ``normalmap`` BSDF (its ``bitmap`` raw, as above)
                       around ``scenefit_phong``, inside the mirror's blend:
                       tangent space about Mitsuba's dP/du, which points as
@@ -292,6 +294,26 @@ def light_plan(L):
             "to_world": columns_matrix(u, v, travel, (0.0, 0.0, 0.0))}
 
 
+def box_texcoords(positions, normals):
+    """scenefit's (u, v) of each vertex of Mitsuba's unit cube (flat lists
+    of x, y, z in [-1, 1] and of each vertex's face normal): every face
+    the whole image, upright and unmirrored seen from outside
+    (src/scene/texture/uv.rs, `box_uv`)."""
+    uv = []
+    for k in range(0, len(positions), 3):
+        x, y, z = ((positions[k + a] + 1.0) / 2.0 for a in range(3))
+        n = normals[k:k + 3]
+        axis = max(range(3), key=lambda a: abs(n[a]))
+        plus = n[axis] > 0.0
+        if axis == 0:
+            uv += [1.0 - z if plus else z, y]
+        elif axis == 1:
+            uv += [x, 1.0 - z if plus else z]
+        else:
+            uv += [x if plus else 1.0 - x, y]
+    return uv
+
+
 def object_plan(o):
     sh, where = o["shape"], "objects.%s.shape" % o["name"]
     stype = sh["type"]
@@ -325,9 +347,10 @@ def object_plan(o):
             # Mitsuba's OBJ loader stores 1 - v (its images run v down)
             ob["material"]["uv"] = ((1.0, 0.0, 0.0), (0.0, -1.0, 1.0))
     else:  # box
-        if mapped:
-            raise SceneError("%s: texture maps on a box are not drawn by mitsuba; use phong" % where)
         lo, hi = sh["min"], sh["max"]
+        # the cube's own texture coordinates are replaced by scenefit's
+        # per face (`box_texcoords`) when it carries maps
+        ob["mapped"] = mapped
         ob["center"] = mul(add(lo, hi), 0.5)
         ob["half"] = mul(sub(hi, lo), 0.5)
     # the object's transform: after the shape's own placement
@@ -893,6 +916,12 @@ class MitsubaBackend:
             if O["shape"] == "box":
                 key = "O%d.vertex_positions" % i
                 self.unit_cubes[key] = [float(x) for x in self.params[key]]
+                if O["mapped"]:
+                    normals = [float(x) for x in self.params["O%d.vertex_normals" % i]]
+                    uv = box_texcoords(self.unit_cubes[key], normals)
+                    tkey = "O%d.vertex_texcoords" % i
+                    self.params[tkey] = type(self.params[tkey])(uv)
+                    self.params.update()
             elif O["shape"] == "mesh" and O["transform"] is not None:
                 for part in ("vertex_positions", "vertex_normals"):
                     key = "O%d.%s" % (i, part)

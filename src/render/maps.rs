@@ -13,8 +13,8 @@ pub const PHONG: &[MapKind] = ALL_MAPS;
 pub const BLENDER: &[MapKind] = ALL_MAPS;
 pub const MITSUBA: &[MapKind] = ALL_MAPS;
 
-/// The maps POV-Ray draws: all four, the normal map on a plane, quad or sphere
-/// only (`povray_refusals`).
+/// The maps POV-Ray draws: all four, the normal map on a plane, quad,
+/// box or sphere only (`povray_refusals`).
 pub const POVRAY: &[MapKind] = ALL_MAPS;
 
 /// Every map refusal of the Blender worker (`mitsuba` false) or the
@@ -27,31 +27,35 @@ pub fn worker_refusals(scene: &Scene, mitsuba: bool) -> Vec<Refusal> {
         ("blender", BLENDER)
     };
     let mut out = refusals(scene, name, drawn);
-    out.extend(limits(scene, mitsuba));
+    out.extend(limits(scene));
     out
 }
 
 /// Every map refusal of POV-Ray: the maps it does not draw, and what it
-/// does not draw them on: a box (no per-face coordinates), glass, a
-/// specular or shininess map beside `specular2` (each is a patterned
-/// texture, and POV-Ray layers nothing over one), a normal map on other
-/// than a plane, quad or sphere (on a sphere not beside a specular or
-/// shininess map).
+/// does not draw them on: glass, a specular or shininess map beside
+/// `specular2` (each is a patterned texture, and POV-Ray layers nothing
+/// over one), a normal map on a mesh, on a sphere beside a specular or
+/// shininess map, or one whose slopes are no height field's on one of
+/// its surfaces (a box's are its six faces).
 pub fn povray_refusals(scene: &Scene) -> Vec<Refusal> {
     let mut out = refusals(scene, "povray", POVRAY);
-    out.extend(limits(scene, true).into_iter().map(|mut r| {
-        r.why = r.why.replace("mitsuba", "mitsuba or povray");
-        r
-    }));
+    out.extend(limits(scene));
     for o in &scene.objects {
         let m = &o.material;
-        let lay = m
-            .normal_map
-            .as_ref()
-            .and_then(|t| super::pov_bumps::laid(&o.shape, t.scale()));
-        if let (Some(t), Some(lay)) = (&m.normal_map, lay) {
+        let lays = m.normal_map.as_ref().and_then(|t| {
+            let faces = o.shape.faces();
+            let lays: Option<Vec<_>> = faces
+                .iter()
+                .map(|f| super::pov_bumps::laid(f, t.scale()))
+                .collect();
+            lays.map(|l| (t, l))
+        });
+        if let Some((t, lays)) = &lays {
             // an unreadable file is the scene check's to report
-            let missed = super::pov_bumps::missed(t, lay).ok().flatten();
+            let missed = lays
+                .iter()
+                .filter_map(|&lay| super::pov_bumps::missed(t, lay).ok().flatten())
+                .max_by(f64::total_cmp);
             if let Some(m) = missed {
                 let why = super::pov_bumps::not_a_height_field(m);
                 out.push(Refusal::new(
@@ -64,16 +68,16 @@ pub fn povray_refusals(scene: &Scene) -> Vec<Refusal> {
             let [a, b, c] = s.axes();
             (a - b).abs() > 1e-9 * a.abs() || (a - c).abs() > 1e-9 * a.abs()
         });
-        if m.normal_map.is_some() && lay.is_some() && uneven {
+        if lays.is_some() && uneven {
             out.push(Refusal::new(
                 format!("objects.{}.transform.scale", o.name),
                 "a normal_map on an object scaled unevenly is not drawn by povray (it turns the height's gradient as a normal, the built-in tracer turns the map's frame); use phong, blender or mitsuba, or scale the shape itself",
             ));
         }
-        if m.normal_map.is_some() && lay.is_none() {
+        if m.normal_map.is_some() && lays.is_none() {
             out.push(Refusal::new(
                 format!("objects.{}.material.normal_map", o.name),
-                "a normal_map is drawn by povray on a plane, quad or sphere only (its normal is a height field's gradient, and on a mesh or box POV-Ray's uv_mapping tilts the normal along the world's axes, not the surface's); use phong, blender or mitsuba",
+                "a normal_map is drawn by povray on a plane, quad, box or sphere only (its normal is a height field's gradient, and on a mesh POV-Ray's uv_mapping tilts the normal along the world's axes, not the surface's); use phong, blender or mitsuba",
             ));
         }
         let patterned = m.specular_map.is_some() || m.shininess_map.is_some();
@@ -95,22 +99,15 @@ pub fn povray_refusals(scene: &Scene) -> Vec<Refusal> {
 }
 
 /// What a worker draws maps on: not glass (Blender's and Mitsuba's
-/// principled BSDF, which takes no maps here), and for Mitsuba
-/// (`refuse_box`) not a box (its `cube` mesh has texture coordinates of
-/// its own; Blender's box template carries scenefit's per face).
-fn limits(scene: &Scene, refuse_box: bool) -> Vec<Refusal> {
+/// principled BSDF, which takes no maps here). A box's faces each hold
+/// the map: Blender's box template and Mitsuba's cube carry scenefit's
+/// coordinates per face, POV-Ray draws the faces as quads.
+fn limits(scene: &Scene) -> Vec<Refusal> {
     let mut out = Vec::new();
     for o in scene.objects.iter().filter(|o| o.material.has_maps()) {
-        let at = format!("objects.{}", o.name);
-        if refuse_box && matches!(o.shape, crate::scene::Shape::Box { .. }) {
-            out.push(Refusal::new(
-                format!("{at}.shape"),
-                "texture maps on a box are not drawn by mitsuba; use phong or blender, or six quads",
-            ));
-        }
         if o.material.transmission > 0.0 {
             out.push(Refusal::new(
-                format!("{at}.material.transmission"),
+                format!("objects.{}.material.transmission", o.name),
                 "texture maps on a transmitting material are drawn by phong only; use phong",
             ));
         }

@@ -88,7 +88,8 @@ impl Lay {
 }
 
 /// How a map at `scale` lies on `shape` for its height field: a plane,
-/// a quad or a sphere; None on a box or a mesh (refused).
+/// a quad or a sphere; None on a box (laid face by face, `Shape::faces`)
+/// or a mesh (refused).
 pub fn laid(shape: &Shape, scale: [f64; 2]) -> Option<Lay> {
     match *shape {
         Shape::Sphere { radius, .. } => Some(Lay::Sphere { radius, scale }),
@@ -137,7 +138,7 @@ pub fn missed(t: &TextureRef, lay: Lay) -> Result<Option<f64>, String> {
 
 /// A planar map's frame (None on a sphere, box or mesh): from the world
 /// vectors of the map's coordinates at its `scale` and the normal.
-pub fn planar_frame(shape: &Shape, scale: [f64; 2]) -> Option<Frame> {
+fn planar_frame(shape: &Shape, scale: [f64; 2]) -> Option<Frame> {
     let v = V3::from;
     let (eu, ev, n) = match *shape {
         Shape::Plane { normal, .. } => {

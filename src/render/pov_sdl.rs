@@ -49,8 +49,10 @@
 //!   map as a pigment averaging three channel patterns, the specular map
 //!   as a patterned texture blending the texture without and with its
 //!   highlight, the shininess map as a patterned texture with an entry
-//!   per exponent. Refused (`maps::povray_refusals`): a map on a box or
-//!   on glass, a specular or shininess map beside `specular2`.
+//!   per exponent; a mapped box as a `union` of its six faces, each a
+//!   `polygon` with the texture placed on it. Refused
+//!   (`maps::povray_refusals`): a map on glass, a specular or shininess
+//!   map beside `specular2`.
 
 use super::backend::Refusal;
 use super::pov_bumps::{self, Lay};
@@ -227,10 +229,41 @@ pub fn sdl_with(scene: &Scene, maps: MapSource) -> Result<String, String> {
     Ok(s)
 }
 
-/// One object: its shape, its texture and its placement.
+/// One object: its shape, its texture and its placement. A box with maps
+/// is its six faces (`Shape::faces`), each a polygon with the texture
+/// placed on it: POV-Ray's `box` has no coordinates per face.
 fn object(s: &mut String, i: usize, o: &Object, maps: MapSource) -> Result<(), String> {
     let mapped = o.material.has_maps();
-    let shape = match o.shape {
+    let place = o.transform.as_ref().map_or(String::new(), placement);
+    if mapped && matches!(o.shape, Shape::Box { .. }) {
+        let _ = writeln!(s, "// objects[{i}], a box as its six faces\nunion {{");
+        for face in o.shape.faces() {
+            let face = Object {
+                shape: face,
+                transform: None,
+                ..o.clone()
+            };
+            let (shape, texture) = (shape_of(&face, true)?, mapped_material(&face, maps)?);
+            let _ = writeln!(s, "{shape}\n  {texture}\n}}");
+        }
+        let _ = writeln!(s, "{place}\n}}");
+        return Ok(());
+    }
+    let shape = shape_of(o, mapped)?;
+    let texture = if mapped {
+        mapped_material(o, maps)?
+    } else {
+        material(&o.material)
+    };
+    // names are never written: the SDL holds only numbers and keywords
+    let _ = writeln!(s, "// objects[{i}]\n{shape}\n  {texture}{place}\n}}");
+    Ok(())
+}
+
+/// An object's shape, its brace left open (`mapped`: a mesh's texture
+/// coordinates written).
+fn shape_of(o: &Object, mapped: bool) -> Result<String, String> {
+    Ok(match o.shape {
         Shape::Sphere { center, radius } => {
             format!("sphere {{ {}, {}", vec(pov(center)), num(radius))
         }
@@ -265,19 +298,7 @@ fn object(s: &mut String, i: usize, o: &Object, maps: MapSource) -> Result<(), S
                 .map_err(|e| format!("objects.{}.shape.file: {e}", o.name))?;
             mesh2(&m, mapped)
         }
-    };
-    let texture = if mapped {
-        mapped_material(o, maps)?
-    } else {
-        material(&o.material)
-    };
-    // names are never written: the SDL holds only numbers and keywords
-    let _ = writeln!(
-        s,
-        "// objects[{i}]\n{shape}\n  {texture}{}\n}}",
-        o.transform.as_ref().map_or(String::new(), placement)
-    );
-    Ok(())
+    })
 }
 
 /// A mesh as `mesh2` (its numbers only, z mirrored like every point):
@@ -726,7 +747,8 @@ fn pattern(file: &str) -> String {
 /// goes before the pattern and what after. A sphere's and a mesh's
 /// `uv_mapping` are scenefit's (measured: within 0.03 % of phong); a
 /// plane and a quad are planar maps carried onto their axes (e_u, e_v;
-/// edge_u, edge_v) by a matrix; a box: None (refused).
+/// edge_u, edge_v) by a matrix; a box: None (`object` writes a mapped
+/// box as its faces, quads).
 fn mapping(shape: &Shape, scale: [f64; 2]) -> Option<(String, String)> {
     let sc = format!(
         " scale <{}, {}, 1>",

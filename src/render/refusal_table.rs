@@ -77,16 +77,9 @@ fn scene_for(field: &str) -> Scene {
             m.normal_map = Some(TextureRef::File("t.png".into()));
             m.specular_map = Some(TextureRef::File("t.png".into()));
         }
-        "a `normal_map` on a `plane`, `quad` or `sphere` more than 5 % of whose slopes are not a height field's there" => {
+        "a `normal_map` on a `plane`, `quad`, `box` or `sphere` more than 5 % of whose slopes are not a height field's there" => {
             m.normal_map = Some(TextureRef::File(twisted_normal_map()));
             s.objects[0].shape = unit_quad();
-        }
-        "a texture map on a `box`" => {
-            m.color_map = Some(TextureRef::File("t.png".into()));
-            s.objects[0].shape = serde_json::from_value(
-                serde_json::json!({"type": "box", "min": [0.0, 0.0, 0.0], "max": [1.0, 1.0, 1.0]}),
-            )
-            .unwrap();
         }
         "a texture map on a material with `transmission` > 0" => {
             m.color_map = Some(TextureRef::File("t.png".into()));

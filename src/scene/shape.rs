@@ -103,6 +103,24 @@ impl Shape {
         }
     }
 
+    /// The surfaces a map is laid on one by one: a box's six faces, each
+    /// a quad laid out as the box lays that face (`texture::uv::box_faces`),
+    /// for a backend whose box has no per-face coordinates; any other shape
+    /// itself.
+    pub fn faces(&self) -> Vec<Shape> {
+        let Shape::Box { min, max } = *self else {
+            return vec![self.clone()];
+        };
+        super::texture::uv::box_faces(V3::from(min), V3::from(max))
+            .into_iter()
+            .map(|(c, u, v)| Shape::Quad {
+                corner: c.to_array(),
+                edge_u: u.to_array(),
+                edge_v: v.to_array(),
+            })
+            .collect()
+    }
+
     /// The tangent frame a normal map is read in at the point `p` (object
     /// frame), by the shape's rule in `texture::tangent`, following its
     /// `uv`; None for a mesh (`texture::tangent::mesh_tangents`).

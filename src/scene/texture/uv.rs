@@ -78,6 +78,27 @@ pub fn box_uv(lo: V3, hi: V3, p: V3) -> [f64; 2] {
     }
 }
 
+/// A box's six faces as quads (corner, edge_u, edge_v) laid out as
+/// `box_uv` lays each face, in `box_face`'s order: a backend whose box has
+/// no per-face coordinates of its own draws a mapped box as these.
+pub fn box_faces(lo: V3, hi: V3) -> [(V3, V3, V3); 6] {
+    let d = hi - lo;
+    let (x, y, z) = (
+        V3::new(d.x, 0.0, 0.0),
+        V3::new(0.0, d.y, 0.0),
+        V3::new(0.0, 0.0, d.z),
+    );
+    let at = |a: f64, b: f64, c: f64| V3::new(a, b, c);
+    [
+        (lo, z, y),                    // -x: u along +z
+        (at(hi.x, lo.y, hi.z), -z, y), // +x: u along -z
+        (lo, x, z),                    // -y: v along +z
+        (at(lo.x, hi.y, hi.z), x, -z), // +y: v along -z
+        (at(hi.x, lo.y, lo.z), -x, y), // -z: u along -x
+        (at(lo.x, lo.y, hi.z), x, y),  // +z
+    ]
+}
+
 /// The face of a box whose plane is nearest `p`, in metres: 0 -x, 1 +x,
 /// 2 -y, 3 +y, 4 -z, 5 +z.
 pub fn box_face(lo: V3, hi: V3, p: V3) -> usize {
@@ -119,6 +140,34 @@ mod tests {
 
     fn close(a: [f64; 2], b: [f64; 2]) -> bool {
         (a[0] - b[0]).abs() < 1e-12 && (a[1] - b[1]).abs() < 1e-12
+    }
+
+    #[test]
+    fn a_box_face_as_a_quad_has_the_box_coordinates_and_tangents() {
+        let (lo, hi) = (V3::new(-1.0, 0.5, -3.0), V3::new(2.0, 1.5, -1.0));
+        for (k, (c, eu, ev)) in box_faces(lo, hi).into_iter().enumerate() {
+            // outward, as the box's face
+            let centre = c + (eu + ev) * 0.5;
+            let n = eu.cross(ev);
+            assert!(
+                n.dot(centre - (lo + hi) * 0.5) > 0.0,
+                "face {k} faces inward"
+            );
+            for (s, t) in [(0.1, 0.2), (0.5, 0.5), (0.9, 0.7), (0.3, 0.95)] {
+                let p = c + eu * s + ev * t;
+                assert_eq!(box_face(lo, hi, p), k, "face {k} at ({s}, {t})");
+                assert!(close(box_uv(lo, hi, p), [s, t]), "face {k} at ({s}, {t})");
+                let tb = super::super::tangent::box_tangents(lo, hi, p);
+                assert!(
+                    (tb.du.normalized() - eu.normalized()).length() < 1e-12,
+                    "face {k}"
+                );
+                assert!(
+                    (tb.dv.normalized() - ev.normalized()).length() < 1e-12,
+                    "face {k}"
+                );
+            }
+        }
     }
 
     #[test]
