@@ -261,27 +261,16 @@ pub fn heights(texels: &Texels, range: [f64; 2], frame: Frame) -> Heights {
     let step_s = (ts * ts + bs * bs).sqrt() / w as f64;
     let step_t = (tt * tt + bt * bt).sqrt() / h as f64;
     let beta = (step_s / step_t).powi(2);
-    let at = |i: usize, r: usize| r * wn + i;
-    let left = |i: usize| (i + wn - 1) % wn;
-    let up = |r: usize| (r + hn - 1) % hn;
-    let mut rhs = vec![0.0; wn * hn];
-    for r in 0..hn {
-        for i in 0..wn {
-            rhs[at(i, r)] =
-                dx[at(left(i), r)] - dx[at(i, r)] + beta * (dy[at(i, up(r))] - dy[at(i, r)]);
-        }
-    }
-    let values = periodic_poisson(&rhs, wn, hn, beta);
-    let (mut misfit, mut total) = (0.0, 0.0);
-    for r in 0..hn {
-        for i in 0..wn {
-            let ex = values[at((i + 1) % wn, r)] - values[at(i, r)] - dx[at(i, r)];
-            let ey = values[at(i, (r + 1) % hn)] - values[at(i, r)] - dy[at(i, r)];
-            misfit += ex * ex + beta * ey * ey;
-            total += dx[at(i, r)].powi(2) + beta * dy[at(i, r)].powi(2);
-        }
-    }
-    Heights::of(w, h, values, (misfit, total), slope2 / (wn * hn) as f64)
+    let steps = Steps {
+        w: wn,
+        dx,
+        dy,
+        ws: vec![1.0; hn],
+        wt: vec![beta; hn],
+    };
+    let values = periodic_poisson(&steps.rhs(), wn, hn, beta);
+    let fit = steps.misfit(&values);
+    Heights::of(w, h, values, fit, slope2 / (wn * hn) as f64)
 }
 
 /// The built-in tracer's gradient G = (x/z, y/z) in its tangent frame
@@ -343,33 +332,66 @@ pub fn sphere_heights(texels: &Texels, range: [f64; 2], radius: f64, scale: [f64
             area += cos_lat(v);
         }
     }
-    let at = |i: usize, r: usize| r * wn + i;
-    let mut rhs = vec![0.0; wn * hn];
-    for r in 0..hn {
-        for i in 0..wn {
-            let left = (i + wn - 1) % wn;
-            let mut b = ws[r] * (dx[at(left, r)] - dx[at(i, r)]) - wt[r] * dy[at(i, r)];
-            if r > 0 {
-                b += wt[r - 1] * dy[at(i, r - 1)];
+    let steps = Steps {
+        w: wn,
+        dx,
+        dy,
+        ws,
+        wt,
+    };
+    let values = sphere_poisson(&steps.rhs(), wn, &steps.ws, &steps.wt);
+    let fit = steps.misfit(&values);
+    Heights::of(w, h, values, fit, slope2 / area.max(1e-12))
+}
+
+/// The height differences wanted between neighbours on a grid of `w`
+/// columns (rows top to bottom), and their weights: `dx` to the right
+/// (columns wrap), weighed `ws[r]` in row r; `dy` down a row, weighed
+/// `wt[r]` below row r, the last row's wrapping to the first (weight 0
+/// where the rows do not wrap: a sphere's poles).
+struct Steps {
+    w: usize,
+    dx: Vec<f64>,
+    dy: Vec<f64>,
+    ws: Vec<f64>,
+    wt: Vec<f64>,
+}
+
+impl Steps {
+    /// The right-hand side of the least squares' normal equations: per
+    /// value, ws (2 x - left - right) + wt[up] (x - up) + wt (x - down).
+    fn rhs(&self) -> Vec<f64> {
+        let (w, h) = (self.w, self.ws.len());
+        let mut b = vec![0.0; w * h];
+        for r in 0..h {
+            let up = (r + h - 1) % h;
+            for i in 0..w {
+                let left = r * w + (i + w - 1) % w;
+                b[r * w + i] = self.ws[r] * (self.dx[left] - self.dx[r * w + i])
+                    + self.wt[up] * self.dy[up * w + i]
+                    - self.wt[r] * self.dy[r * w + i];
             }
-            rhs[at(i, r)] = b;
         }
+        b
     }
-    let values = sphere_poisson(&rhs, wn, &ws, &wt);
-    let (mut misfit, mut total) = (0.0, 0.0);
-    for r in 0..hn {
-        for i in 0..wn {
-            let ex = values[at((i + 1) % wn, r)] - values[at(i, r)] - dx[at(i, r)];
-            misfit += ws[r] * ex * ex;
-            total += ws[r] * dx[at(i, r)].powi(2);
-            if r + 1 < hn {
-                let ey = values[at(i, r + 1)] - values[at(i, r)] - dy[at(i, r)];
-                misfit += wt[r] * ey * ey;
-                total += wt[r] * dy[at(i, r)].powi(2);
+
+    /// The weighed squared misfit of the heights `x` to the differences,
+    /// and the weighed squared differences themselves.
+    fn misfit(&self, x: &[f64]) -> (f64, f64) {
+        let (w, h) = (self.w, self.ws.len());
+        let (mut misfit, mut total) = (0.0, 0.0);
+        for r in 0..h {
+            let down = (r + 1) % h;
+            for i in 0..w {
+                let at = r * w + i;
+                let ex = x[r * w + (i + 1) % w] - x[at] - self.dx[at];
+                let ey = x[down * w + i] - x[at] - self.dy[at];
+                misfit += self.ws[r] * ex * ex + self.wt[r] * ey * ey;
+                total += self.ws[r] * self.dx[at].powi(2) + self.wt[r] * self.dy[at].powi(2);
             }
         }
+        (misfit, total)
     }
-    Heights::of(w, h, values, (misfit, total), slope2 / area.max(1e-12))
 }
 
 /// Solves the sphere's normal equations for heights x on `w` columns
