@@ -639,7 +639,7 @@ fn placed(
         _ => None,
     };
     let ch = maps(t, k, lay).map_err(|e| format!("objects.{}.material.{e}", o.name))?;
-    let (pre, mut post) = mapping(&o.shape, t.scale()).ok_or_else(|| {
+    let (pre, mut post) = mapping(&o.shape, t.scale(), k).ok_or_else(|| {
         format!(
             "objects.{}.material.{}: not drawn on this shape by POV-Ray",
             o.name,
@@ -699,32 +699,28 @@ fn mapped_normal(
     if ch.scale <= 0.0 {
         return Ok(String::new());
     }
-    if let Shape::Sphere { center, radius } = o.shape {
-        if outer.is_some() {
-            // the scene check's refusal (`maps::povray_refusals`); a guard
-            return Err(format!(
-                "objects.{}.material.normal_map: on a sphere beside a specular or shininess map, not drawn by POV-Ray",
-                o.name
-            ));
+    // a sphere's heights are a spherical image about its centre (`mapping`)
+    let (image, accuracy) = match o.shape {
+        Shape::Sphere { radius, .. } => {
+            if outer.is_some() {
+                // the scene check's refusal (`maps::povray_refusals`); a guard
+                return Err(format!(
+                    "objects.{}.material.normal_map: on a sphere beside a specular or shininess map, not drawn by POV-Ray",
+                    o.name
+                ));
+            }
+            let image = format!(
+                "image_pattern {{ png \"{}\" gamma 1.0 map_type 1 interpolate 2 }}",
+                ch.files[0]
+            );
+            (image, BUMP_ACCURACY * radius)
         }
-        // A sphere's heights are laid over its longitude and latitude as
-        // POV-Ray's spherical image map reads a direction from the
-        // origin (`pov_bumps::sphere_heights`): a pattern of the point in
-        // space whose gradient lies in the surface. `uv_mapping` would
-        // tilt the normal along the world's axes instead.
-        return Ok(format!(
-            " normal {{ image_pattern {{ png \"{}\" gamma 1.0 map_type 1 interpolate 2 }} bump_size {} accuracy {} translate {} }}",
-            ch.files[0],
-            num(ch.scale / BUMP_GAIN),
-            num(BUMP_ACCURACY * radius),
-            vec(pov(center))
-        ));
-    }
+        _ => (pattern(&ch.files[0]), BUMP_ACCURACY),
+    };
     Ok(format!(
-        " normal {{ {pre}{} bump_size {} accuracy {}{post} }}",
-        pattern(&ch.files[0]),
+        " normal {{ {pre}{image} bump_size {} accuracy {}{post} }}",
         num(ch.scale / BUMP_GAIN),
-        num(BUMP_ACCURACY)
+        num(accuracy)
     ))
 }
 
@@ -745,11 +741,16 @@ fn pattern(file: &str) -> String {
 /// How a pattern in POV-Ray's image space [0, 1]^2 lands on `shape` at
 /// scenefit's (u, v) x `scale` (docs/scene-format.md "Textures"): what
 /// goes before the pattern and what after. A sphere's and a mesh's
-/// `uv_mapping` are scenefit's (measured: within 0.03 % of phong); a
+/// `uv_mapping` are scenefit's (measured: within 0.03 % of phong), but
+/// not for a sphere's normal map (`k`): its heights are laid over the
+/// longitude and latitude as POV-Ray's spherical image (`map_type 1`)
+/// reads the direction from the centre (`pov_bumps::sphere_heights`), a
+/// pattern of the point in space whose gradient lies in the surface,
+/// where `uv_mapping` would tilt the normal along the world's axes; a
 /// plane and a quad are planar maps carried onto their axes (e_u, e_v;
 /// edge_u, edge_v) by a matrix; a box: None (`object` writes a mapped
 /// box as its faces, quads).
-fn mapping(shape: &Shape, scale: [f64; 2]) -> Option<(String, String)> {
+fn mapping(shape: &Shape, scale: [f64; 2], k: MapKind) -> Option<(String, String)> {
     let sc = format!(
         " scale <{}, {}, 1>",
         num(1.0 / scale[0]),
@@ -768,6 +769,9 @@ fn mapping(shape: &Shape, scale: [f64; 2]) -> Option<(String, String)> {
         format!(" matrix <{}>", m.join(", "))
     };
     match *shape {
+        Shape::Sphere { center, .. } if k == MapKind::Normal => {
+            Some((String::new(), format!(" translate {}", vec(pov(center)))))
+        }
         Shape::Sphere { .. } | Shape::Mesh { .. } => Some(("uv_mapping ".into(), sc)),
         Shape::Plane { point, normal } => {
             let (eu, ev) = crate::scene::texture::uv::plane_axes(V3::from(normal));
