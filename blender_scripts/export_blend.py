@@ -11,9 +11,10 @@ scene_common.py and jsonlines.py beside this script:
 The scene is built by the Blender worker's own code (worker.Worker.build and
 apply: one translation of a scene for Blender, not two), then:
 
-- a material's `color_map` (the one map the worker does not draw) becomes an
-  Image Texture on the diffuse colour, through the mesh's UV map;
-- every image is packed into the .blend; meshes are datablocks in it;
+- the texture maps are the worker's own nodes (each map a float image of
+  the decoded values, on every shape as the backend draws it);
+- every image is packed into the .blend (the worker's generated ones as
+  OpenEXR, lossless for their float values); meshes are datablocks in it;
 - each object, light and material carries a custom property (scenefit_name,
   scenefit_material) so that `scenefit import` reads back the names and
   the material values (the worker's Blinn-Phong node graph has no
@@ -44,33 +45,8 @@ def _args():
     return rest
 
 
-def color_map_nodes(mat, socket, albedo, cmap):
-    """Diffuse colour = albedo x the image, looked up by the UV map with the
-    map's `scale` (u, v repeat per unit), as scenefit's color_map."""
-    nt = mat.node_tree
-    N, L = nt.nodes, nt.links
-    img = bpy.data.images.load(cmap["file"], check_existing=True)
-    img.colorspace_settings.name = "sRGB" if cmap["encoding"] == "srgb" else "Non-Color"
-    img.alpha_mode = "NONE"
-    uv = N.new("ShaderNodeTexCoord")
-    mapping = N.new("ShaderNodeMapping")
-    mapping.inputs["Scale"].default_value = (cmap["scale"][0], cmap["scale"][1], 1.0)
-    tex = N.new("ShaderNodeTexImage")
-    tex.image = img
-    tex.interpolation = "Linear"
-    tex.extension = "REPEAT"
-    mix = N.new("ShaderNodeMixRGB")
-    mix.blend_type = "MULTIPLY"
-    mix.inputs[0].default_value = 1.0
-    mix.inputs[1].default_value = (albedo[0], albedo[1], albedo[2], 1.0)
-    L.new(uv.outputs["UV"], mapping.inputs["Vector"])
-    L.new(mapping.outputs["Vector"], tex.inputs["Vector"])
-    L.new(tex.outputs["Color"], mix.inputs[2])
-    L.new(mix.outputs["Color"], socket)
-
-
 def tag(w, scene, desc):
-    """Plain names, the scenefit_* properties and the colour maps."""
+    """Plain names and the scenefit_* properties."""
     w.cam_obj.name = "Camera"
     for (lo, _), L in zip(w.lights, desc["lights"]):
         lo.name = lo.data.name = L["name"]
@@ -84,16 +60,16 @@ def tag(w, scene, desc):
         mat = ent["mat"]
         mat.name = name
         mat["scenefit_material"] = json.dumps(entries[name].get("material") or {}, sort_keys=True)
-        cmap = o["material"]["maps"].get("color_map")
-        if cmap is not None:
-            nodes = ent["nodes"]
-            socket = (nodes["diffuse"].inputs["Color"] if "diffuse" in nodes
-                      else nodes["principled"].inputs["Base Color"])
-            if not ent["obj"].data.uv_layers:
-                raise worker.SceneError(
-                    "objects.%s: Blender read no texture coordinates from %s (its PLY importer "
-                    "reads s, t; write them under those names, or use OBJ)" % (name, o["shape"]["file"]))
-            color_map_nodes(mat, socket, o["material"]["albedo"], cmap)
+
+
+def pack_maps():
+    """The worker's decoded map images, generated in memory, packed as
+    OpenEXR (a generated image is not an external file: `pack_all` leaves
+    it out, and it would be saved empty)."""
+    for img in bpy.data.images:
+        if img.name.startswith(worker.PREFIX + "map_") and img.packed_file is None:
+            img.file_format = "OPEN_EXR"
+            img.pack()
 
 
 def main():
@@ -105,6 +81,7 @@ def main():
     w.build(worker.structure_of(desc))
     w.apply(desc)
     tag(w, scene, desc)
+    pack_maps()
     s = bpy.context.scene
     s.cycles.seed = 0
     r = s.render

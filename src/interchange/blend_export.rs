@@ -2,12 +2,12 @@
 //! .blend saved by Blender, built by the Blender backend's own worker code
 //! (blender_scripts/export_blend.py), so that Blender renders it as
 //! scenefit's Blender backend does (docs/interchange.md, "Blender").
-//! What the backend refuses is refused here too, except a `color_map`
-//! with its default `range` on a mesh, which the export draws itself.
+//! What the backend refuses is refused here too; the texture maps are
+//! the worker's own nodes, their decoded images packed into the file.
 
 use super::blend_run;
 use crate::error::{Error, Result};
-use crate::scene::{Scene, Shape};
+use crate::scene::Scene;
 use std::path::Path;
 
 /// Writes `out` (a new .blend) from the scene file `scene_path`.
@@ -65,38 +65,16 @@ fn check_output(out: &Path) -> Result<()> {
     Ok(())
 }
 
-/// The Blender backend's refusals, less the colour maps the export draws;
-/// a colour map elsewhere than on a mesh (whose UVs it uses) or with a
-/// `range` is refused.
+/// The Blender backend's refusals: the export draws what the backend
+/// draws (its worker builds the .blend), every texture map included.
 fn refuse_undrawn(scene: &Scene, file: &str) -> Result<()> {
     let (backend, _) = crate::render::registry::find("blender")?;
-    let drawn = |field: &str| {
-        let Some(name) = field
-            .strip_prefix("objects.")
-            .and_then(|f| f.strip_suffix(".material.color_map"))
-        else {
-            return false;
-        };
-        scene.objects.iter().any(|o| {
-            o.name == name
-                && matches!(o.shape, Shape::Mesh { .. })
-                && o.material.color_map.as_ref().is_some_and(default_range)
-        })
-    };
-    let refused = (backend.supports)(scene);
-    match refused.iter().find(|r| !drawn(&r.field)) {
+    match (backend.supports)(scene).first() {
         Some(r) => Err(Error::invalid(
             file,
             r.field.clone(),
             format!("cannot be exported to Blender: {}", r.why),
         )),
         None => Ok(()),
-    }
-}
-
-fn default_range(t: &crate::scene::texture::TextureRef) -> bool {
-    match t {
-        crate::scene::texture::TextureRef::File(_) => true,
-        crate::scene::texture::TextureRef::Spec(s) => s.range.is_none_or(|r| r == [0.0, 1.0]),
     }
 }
