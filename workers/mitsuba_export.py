@@ -36,7 +36,7 @@ import sys
 from xml.sax.saxutils import quoteattr
 
 import mitsuba_worker
-from scene_common import SceneError, cross
+from scene_common import SceneError
 
 # What each key of build_dict's description is in XML: the tag of a nested
 # plug-in by its key (objects O*, lights L* by their own type below).
@@ -129,39 +129,26 @@ class Exporter(mitsuba_worker.MitsubaBackend):
         return d
 
 
-# The unit cube's faces as scenefit lays a box's (src/scene/texture/uv.rs,
-# `box_faces`): corner, edge along u, edge along v; each face the whole
-# image, edge_u x edge_v outward.
-UNIT_CUBE_FACES = (
-    ((-1, -1, -1), (0, 0, 2), (0, 2, 0)),   # -x
-    ((1, -1, 1), (0, 0, -2), (0, 2, 0)),    # +x
-    ((-1, -1, -1), (2, 0, 0), (0, 0, 2)),   # -y
-    ((-1, 1, 1), (2, 0, 0), (0, 0, -2)),    # +y
-    ((1, -1, -1), (-2, 0, 0), (0, 2, 0)),   # -z
-    ((-1, -1, 1), (2, 0, 0), (0, 2, 0)),    # +z
-)
-
-
-def write_unit_cube(path):
-    """The cube [-1, 1]^3 as an ASCII PLY: four vertices a face with its
-    outward normal and scenefit's (u, v), two triangles a face."""
-    verts, tris = [], []
-    for c, eu, ev in UNIT_CUBE_FACES:
-        n = [x / 4.0 for x in cross(eu, ev)]
-        base = len(verts)
-        for s, t in ((0, 0), (1, 0), (1, 1), (0, 1)):
-            p = [c[k] + s * eu[k] + t * ev[k] for k in range(3)]
-            verts.append(p + n + [s, t])
-        tris += [(base, base + 1, base + 2), (base, base + 2, base + 3)]
+def write_unit_cube(mi, path):
+    """Mitsuba's own cube [-1, 1]^3 (the worker's box) as an ASCII PLY
+    with the (u, v) the worker gives it (`box_texcoords`), so the layout
+    of a box's faces is stated once on the Python side."""
+    params = mi.traverse(mi.load_dict({"type": "cube"}))
+    pos = [float(x) for x in params["vertex_positions"]]
+    nor = [float(x) for x in params["vertex_normals"]]
+    faces = [int(x) for x in params["faces"]]
+    uv = mitsuba_worker.box_texcoords(pos, nor)
+    n = len(pos) // 3
     with open(path, "w") as f:
-        f.write("ply\nformat ascii 1.0\nelement vertex %d\n" % len(verts))
+        f.write("ply\nformat ascii 1.0\nelement vertex %d\n" % n)
         for name in ("x", "y", "z", "nx", "ny", "nz", "u", "v"):
             f.write("property float %s\n" % name)
-        f.write("element face %d\nproperty list uchar int vertex_indices\nend_header\n" % len(tris))
-        for v in verts:
-            f.write(" ".join("%g" % x for x in v) + "\n")
-        for t in tris:
-            f.write("3 %d %d %d\n" % t)
+        f.write("element face %d\nproperty list uchar int vertex_indices\nend_header\n" % (len(faces) // 3))
+        for k in range(n):
+            row = pos[3 * k:3 * k + 3] + nor[3 * k:3 * k + 3] + uv[2 * k:2 * k + 2]
+            f.write(" ".join("%r" % x for x in row) + "\n")
+        for k in range(0, len(faces), 3):
+            f.write("3 %d %d %d\n" % tuple(faces[k:k + 3]))
 
 
 def describe_for_xml(ex, plan, names):
@@ -202,7 +189,7 @@ def describe_for_xml(ex, plan, names):
                     # box is a unit cube mesh carrying scenefit's per face
                     rel = os.path.join("meshes", safe(o["name"]) + ".ply")
                     os.makedirs(os.path.join(ex.out, "meshes"), exist_ok=True)
-                    write_unit_cube(os.path.join(ex.out, rel))
+                    write_unit_cube(ex.mi, os.path.join(ex.out, rel))
                     value["type"], value["filename"] = "ply", rel
             out[(names["O"][int(key[1:])], key)] = value
         elif key.startswith("L") and key[1:].isdigit():

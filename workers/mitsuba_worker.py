@@ -912,6 +912,7 @@ class MitsubaBackend:
         self.scene = scene
         self.params = mi.traverse(scene)
         self.mesh_files = {}
+        texcoords_set = False
         for i, O in enumerate(plan["objects"]):
             if O["shape"] == "box":
                 key = "O%d.vertex_positions" % i
@@ -921,13 +922,14 @@ class MitsubaBackend:
                     uv = box_texcoords(self.unit_cubes[key], normals)
                     tkey = "O%d.vertex_texcoords" % i
                     self.params[tkey] = type(self.params[tkey])(uv)
-                    self.params.update()
+                    texcoords_set = True
             elif O["shape"] == "mesh" and O["transform"] is not None:
                 for part in ("vertex_positions", "vertex_normals"):
                     key = "O%d.%s" % (i, part)
                     if key in self.params:
                         self.mesh_files[key] = type(self.params[key])(self.params[key])
-        self.write_values(self.plan_values(plan), force=True)
+        if self.write_values(self.plan_values(plan), force=True) == 0 and texcoords_set:
+            self.params.update()
         self.frozen = self.freezable(plan)
         self.signature = signature
         self.rebuilds += 1
