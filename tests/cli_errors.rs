@@ -331,6 +331,7 @@ fn negative_numbers_name_their_option() {
             "--restart-generations",
         ),
         (vec!["diagnose", "fitdir", "-o", "out"], "--max-effects"),
+        (vec!["diagnose", "fitdir", "-o", "out"], "--min-gain"),
         (vec!["diagnose", "fitdir", "-o", "out"], "--seed"),
         (vec!["diagnose", "fitdir", "-o", "out"], "--jobs"),
         (vec!["demo", "-o", "out"], "--population"),

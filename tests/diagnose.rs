@@ -1,8 +1,9 @@
 //! `scenefit diagnose` on generated data (tests/effects_data): the first
 //! accepted effect is the planted one for all but one of the effects, the
 //! deviation falls to at most half for every one, noise-only targets
-//! accept nothing, the diagnosis does not depend on `--jobs`, and
-//! `--effects` limits the effects tried.
+//! accept nothing, the diagnosis does not depend on `--jobs`,
+//! `--effects` limits the effects tried, and `--min-gain` refuses an
+//! effect that gains less.
 
 mod effects_data;
 
@@ -161,4 +162,41 @@ fn only_the_effects_named_are_tried() {
         tried(&without)
     );
     assert!(!without.accepted.iter().any(|a| a == "vignetting"));
+}
+
+/// `--min-gain` (`DiagnoseConfig::min_gain`): an effect the default
+/// accepts is refused once the least gain asked is above its own, and
+/// diagnosis.json records which threshold ran. (Noise keeps the gain
+/// under 1: without it the planted effect explains everything.)
+#[test]
+fn an_effect_under_the_least_gain_asked_is_refused() {
+    let named: Option<Vec<String>> = Some(vec!["light_color".into(), "vignetting".into()]);
+    let first = diagnose_case_with("vignetting", 0, 5, 1.0, |c| c.effects = named.clone());
+    assert_eq!(first.min_gain, DiagnoseConfig::default().min_gain);
+    let gain = first
+        .candidates
+        .iter()
+        .find(|c| c.effect == "vignetting" && c.accepted)
+        .and_then(|c| c.gain)
+        .expect("vignetting accepted, with its gain");
+    assert!(gain < 1.0, "gain {gain}");
+    let above = (1.0 + gain) / 2.0;
+    let second = diagnose_case_with("vignetting", 0, 5, 1.0, |c| {
+        c.effects = named.clone();
+        c.min_gain = above;
+    });
+    assert_eq!(second.min_gain, above);
+    assert!(
+        !second.accepted.iter().any(|a| a == "vignetting"),
+        "{:?}",
+        second.accepted
+    );
+    for c in second.candidates.iter().filter(|c| c.accepted) {
+        assert!(
+            c.gain.is_some_and(|g| g >= above),
+            "{} {:?}",
+            c.effect,
+            c.gain
+        );
+    }
 }

@@ -40,6 +40,11 @@ pub struct DiagnoseArgs {
     /// Effects accepted at most.
     #[arg(long, default_value_t = 3, value_parser = super::numbers::whole, allow_hyphen_values = true)]
     max_effects: usize,
+    /// Least fraction by which an effect must lower the sum of absolute
+    /// differences to be accepted, beside the criterion (docs/diagnose.md,
+    /// "How an effect is accepted").
+    #[arg(long, default_value_t = DiagnoseConfig::default().min_gain, value_parser = super::numbers::fraction, allow_hyphen_values = true)]
+    min_gain: f64,
     /// Try only these effects (names as in docs/diagnose.md's table), e.g.
     /// `albedo_map` alone for a per-texel Lambertian baseline; default:
     /// every effect.
@@ -99,6 +104,7 @@ pub fn run(a: DiagnoseArgs) -> Result<()> {
         search_generations: a.generations / 2,
         refine_generations: a.generations - a.generations / 2,
         max_rounds: a.max_effects,
+        min_gain: a.min_gain,
         restart_generations: a.restart_generations,
         seed: a.seed,
         refit_geometry: a.refit_geometry,

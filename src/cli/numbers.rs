@@ -57,6 +57,14 @@ pub(crate) fn number(s: &str) -> Result<f64, String> {
     }
 }
 
+/// A fraction from 0 up to, not including, 1 (`diagnose --min-gain`).
+pub(crate) fn fraction(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(x) if (0.0..1.0).contains(&x) => Ok(x),
+        _ => Err("expected a fraction from 0 up to 1, e.g. 0.05".into()),
+    }
+}
+
 /// `positive_count` for pixel sizes: 1 to the scene format's limit.
 pub(crate) fn pixels(s: &str) -> Result<u32, String> {
     let max = crate::scene::limits::MAX_IMAGE_SIDE;
@@ -97,6 +105,15 @@ mod tests {
         assert_eq!(number("-0.5"), Ok(-0.5));
         for s in ["nan", "inf", "-inf", "x"] {
             assert!(number(s).is_err(), "{s}");
+        }
+    }
+
+    #[test]
+    fn fractions_are_below_one() {
+        assert_eq!(fraction("0"), Ok(0.0));
+        assert_eq!(fraction("0.05"), Ok(0.05));
+        for s in ["1", "-0.01", "nan", "x"] {
+            assert!(fraction(s).is_err(), "{s}");
         }
     }
 }

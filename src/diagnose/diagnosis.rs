@@ -62,6 +62,9 @@ pub struct Diagnosis {
     pub unexplained: bool,
     pub renders: usize,
     pub wall_seconds: f64,
+    /// The least SAD gain an effect needed to be accepted (`--min-gain`):
+    /// the one threshold a user may move, so a diagnosis says which it ran.
+    pub min_gain: f64,
     /// Free entries held at the fit's values through the diagnosis
     /// (shared geometry, `held.rs`); free again in improved_scene.json.
     #[serde(skip_serializing_if = "Vec::is_empty")]

@@ -161,6 +161,7 @@ fn diagnose(
         unexplained,
         renders: fits.renders,
         wall_seconds: started.elapsed().as_secs_f64(),
+        min_gain: config.min_gain,
         held: held::paths(&held),
         removed,
         imitations,

@@ -245,6 +245,7 @@ mod tests {
             unexplained: false,
             renders: 1234,
             wall_seconds: 5.0,
+            min_gain: 0.05,
             held: Vec::new(),
             removed: Vec::new(),
             imitations: vec![super::super::diagnosis::Imitation {
