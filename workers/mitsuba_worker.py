@@ -912,7 +912,6 @@ class MitsubaBackend:
         self.scene = scene
         self.params = mi.traverse(scene)
         self.mesh_files = {}
-        texcoords_set = False
         for i, O in enumerate(plan["objects"]):
             if O["shape"] == "box":
                 key = "O%d.vertex_positions" % i
@@ -921,15 +920,15 @@ class MitsubaBackend:
                     normals = [float(x) for x in self.params["O%d.vertex_normals" % i]]
                     uv = box_texcoords(self.unit_cubes[key], normals)
                     tkey = "O%d.vertex_texcoords" % i
+                    # applied by the update of write_values(force=True) below: the
+                    # sensor is always among the values it writes
                     self.params[tkey] = type(self.params[tkey])(uv)
-                    texcoords_set = True
             elif O["shape"] == "mesh" and O["transform"] is not None:
                 for part in ("vertex_positions", "vertex_normals"):
                     key = "O%d.%s" % (i, part)
                     if key in self.params:
                         self.mesh_files[key] = type(self.params[key])(self.params[key])
-        if self.write_values(self.plan_values(plan), force=True) == 0 and texcoords_set:
-            self.params.update()
+        self.write_values(self.plan_values(plan), force=True)
         self.frozen = self.freezable(plan)
         self.signature = signature
         self.rebuilds += 1

@@ -42,7 +42,7 @@ pub struct DiagnoseArgs {
     max_effects: usize,
     /// Least fraction by which an effect must lower the sum of absolute
     /// differences to be accepted, beside the criterion (docs/diagnose.md,
-    /// "How an effect is accepted").
+    /// "The least gain").
     #[arg(long, default_value_t = DiagnoseConfig::default().min_gain, value_parser = super::numbers::fraction, allow_hyphen_values = true)]
     min_gain: f64,
     /// Try only these effects (names as in docs/diagnose.md's table), e.g.
