@@ -605,10 +605,12 @@ fn povray_draws_a_normal_map_on_a_quad_a_box_and_a_plane_as_the_built_in_tracer_
 /// POV-Ray draws a normal map made for a sphere (the height field over
 /// its longitude and latitude, `pov_bumps::sphere_heights`, read as a
 /// spherical image) as the built-in tracer does: on a sphere turned by
-/// its transform, a smaller one, and beside a colour map; within 1 % and
-/// a quarter of what the map itself changes. A flat tile's map wrapped on
-/// a sphere, which no height there has, and a normal map beside a
-/// specular map (laid by `uv_mapping`) are refused, not drawn wrong.
+/// its transform, a smaller one, beside a colour map, and beside a
+/// colour, a specular and a shininess map (every map of the sphere then a
+/// spherical image, `pov_bumps::over_sphere`, one at a scale that is not
+/// whole); within 1 % and a quarter of what the map itself changes. A
+/// flat tile's map wrapped on a sphere, which no height there has, is
+/// refused, not drawn wrong.
 #[test]
 fn povray_draws_a_normal_map_made_for_a_sphere_as_the_built_in_tracer_does() {
     if !common::have("povray", "POV-Ray") {
@@ -630,10 +632,25 @@ fn povray_draws_a_normal_map_made_for_a_sphere_as_the_built_in_tracer_does() {
     let plain = json!({"color": [0.6, 0.6, 0.6], "specular": 0.3, "shininess": 20});
     let mut coloured = plain.clone();
     coloured["color_map"] = json!({"file": textured.join("checker.png"), "scale": [2, 1]});
+    let mut patterned = coloured.clone();
+    patterned["specular_map"] = json!({"file": textured.join("stripes.png"), "scale": [1.5, 1]});
+    patterned["shininess_map"] =
+        json!({"file": textured.join("stripes.png"), "scale": [3, 2], "range": [8, 60]});
+    let mut shiny = plain.clone();
+    shiny["specular"] = json!(0.8);
+    shiny["shininess_map"] =
+        json!({"file": textured.join("stripes.png"), "scale": [2, 2], "range": [3, 300]});
     for (name, radius, material, turned) in [
         ("turned", 0.9, &plain, true),
         ("small", 0.6, &plain, false),
         ("beside a colour map", 0.9, &coloured, true),
+        (
+            "beside colour, specular and shininess maps",
+            0.9,
+            &patterned,
+            true,
+        ),
+        ("beside a shininess map", 0.9, &shiny, false),
     ] {
         let mut mapped = material.clone();
         mapped["normal_map"] = json!({"file": bumps});
@@ -652,6 +669,20 @@ fn povray_draws_a_normal_map_made_for_a_sphere_as_the_built_in_tracer_does() {
                 "{name}: {dev:.3} % (the map moves {effect:.3} %)"
             );
         }
+        // the highlight's maps land where phong puts them, not just anywhere
+        if material.get("shininess_map").is_some() {
+            let mut bare = mapped.clone();
+            let o = bare.as_object_mut().unwrap();
+            o.remove("specular_map");
+            o.remove("shininess_map");
+            let bare = render(&ball(radius, &bare, turned), "phong").unwrap();
+            let theirs = scenefit::metric::deviation(&bare, &phong, None).average;
+            eprintln!("{name}: the specular and shininess maps' own effect {theirs:.3} %");
+            assert!(
+                dev < 0.5 * theirs,
+                "{name}: {dev:.3} % (those maps move {theirs:.3} %)"
+            );
+        }
     }
     let refused = |material: Value| match render(&ball(0.9, &material, false), "povray") {
         Ok(_) => panic!("drawn: {material}"),
@@ -661,11 +692,6 @@ fn povray_draws_a_normal_map_made_for_a_sphere_as_the_built_in_tracer_does() {
     flat_tile["normal_map"] = json!({"file": textured.join("bumps.png"), "scale": [6, 3]});
     let why = refused(flat_tile);
     assert!(why.contains("height field"), "{why}");
-    let mut beside = plain.clone();
-    beside["normal_map"] = json!({"file": bumps});
-    beside["specular_map"] = json!({"file": textured.join("stripes.png")});
-    let why = refused(beside);
-    assert!(why.contains("specular_map or shininess_map"), "{why}");
 }
 
 /// Mitsuba (`normalmap` BSDF) and Blender (Normal Map node) draw the

@@ -34,9 +34,8 @@ pub fn worker_refusals(scene: &Scene, mitsuba: bool) -> Vec<Refusal> {
 /// Every map refusal of POV-Ray: the maps it does not draw, and what it
 /// does not draw them on: glass, a specular or shininess map beside
 /// `specular2` (each is a patterned texture, and POV-Ray layers nothing
-/// over one), a normal map on a mesh, on a sphere beside a specular or
-/// shininess map, or one whose slopes are no height field's on one of
-/// its surfaces (a box's are its six faces).
+/// over one), a normal map on a mesh, or one whose slopes are no height
+/// field's on one of its surfaces (a box's are its six faces).
 pub fn povray_refusals(scene: &Scene) -> Vec<Refusal> {
     let mut out = refusals(scene, "povray", POVRAY);
     out.extend(limits(scene));
@@ -81,13 +80,6 @@ pub fn povray_refusals(scene: &Scene) -> Vec<Refusal> {
             ));
         }
         let patterned = m.specular_map.is_some() || m.shininess_map.is_some();
-        let sphere = matches!(o.shape, crate::scene::Shape::Sphere { .. });
-        if m.normal_map.is_some() && sphere && patterned {
-            out.push(Refusal::new(
-                format!("objects.{}.material.normal_map", o.name),
-                "a normal_map on a sphere beside a specular_map or shininess_map is not drawn by povray (their patterned texture is laid by uv_mapping, which hands the normal's pattern the surface's coordinates, not its point); use phong, blender or mitsuba",
-            ));
-        }
         if patterned && m.specular2.is_some_and(|k| k > 0.0) {
             out.push(Refusal::new(
                 format!("objects.{}.material.specular2", o.name),

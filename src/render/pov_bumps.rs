@@ -283,6 +283,44 @@ fn gradient(texels: &Texels, [lo, hi]: [f64; 2], s: f64, t: f64) -> (f64, f64) {
     (r / z, g / z)
 }
 
+/// Most texels a side of a map laid over a sphere (`over_sphere`): 200 MB
+/// of colour at most.
+const MAX_LAID: u32 = 4096;
+
+/// The map `texels` repeated `scale` times around and up a sphere, laid
+/// out over its whole longitude (columns) and latitude (rows from the
+/// north pole down) as the normal map's heights are (`sphere_heights`),
+/// so that every map of a sphere with a normal map is one spherical
+/// image about its centre: its patterns then sit in one space, the
+/// point's, and nest in each other's textures, where `uv_mapping` hands
+/// a nested pattern the surface's coordinates. At a whole `scale` it is
+/// the texels repeated, so POV-Ray's bilinear lookup gives what it gives
+/// on the map itself; otherwise sampled `FINE` times finer. At most
+/// `MAX_LAID` a side (a larger one is sampled down to it).
+pub fn over_sphere(texels: &Texels, scale: [f64; 2]) -> Arc<Texels> {
+    let reps = scale.map(|x| x.abs().ceil().max(1.0) as u32);
+    let (tw, th) = (texels.width * reps[0], texels.height * reps[1]);
+    let whole = scale.iter().all(|x| x.abs().fract() == 0.0);
+    let f = match whole {
+        true => 1,
+        false => FINE.min((MAX_LAID / tw.max(th).max(1)).max(1)),
+    };
+    let (w, h) = ((tw * f).min(MAX_LAID), (th * f).min(MAX_LAID));
+    let mut values = Vec::with_capacity(3 * (w * h) as usize);
+    for r in 0..h {
+        let v = 1.0 - (r as f64 + 0.5) / h as f64;
+        for i in 0..w {
+            let u = (i as f64 + 0.5) / w as f64;
+            values.extend(texels.sample(u * scale[0], v * scale[1]));
+        }
+    }
+    Arc::new(Texels {
+        width: w,
+        height: h,
+        values,
+    })
+}
+
 /// The height field of the normal map `texels` on a sphere of `radius`,
 /// the map repeated `scale` times around and up it, laid out over the
 /// whole sphere by longitude (u, columns, wrapping) and latitude (v, rows
@@ -699,5 +737,35 @@ mod tests {
             .zip(&h.values)
             .fold(0.0f64, |m, (t, v)| m.max((t - mean - v).abs()));
         assert!(worst < 0.05 * a, "worst {worst} of amplitude {a}");
+    }
+
+    /// A map laid over a sphere at a whole scale is its texels repeated
+    /// (to rounding); at another scale it is finer, and each laid texel is the
+    /// map's value where that texel's centre falls.
+    #[test]
+    fn a_map_laid_over_a_sphere_repeats_its_texels() {
+        let values: Vec<f32> = (0..6).flat_map(|k| [k as f32 / 8.0; 3]).collect();
+        let map = Texels {
+            width: 3,
+            height: 2,
+            values,
+        };
+        let laid = over_sphere(&map, [2.0, 3.0]);
+        assert_eq!((laid.width, laid.height), (6, 6));
+        for r in 0..6 {
+            for i in 0..6 {
+                let k = 3 * (r * 6 + i);
+                let want = map.values[3 * ((r % 2) * 3 + i % 3)];
+                assert!((laid.values[k] - want).abs() < 1e-6, "texel ({i}, {r})");
+            }
+        }
+        let laid = over_sphere(&map, [1.5, 1.0]);
+        assert_eq!((laid.width, laid.height), (3 * 2 * FINE, 2 * FINE));
+        let (w, h) = (laid.width as f64, laid.height as f64);
+        for (i, r) in [(0, 0), (5, 3), (17, 7)] {
+            let (u, v) = ((i as f64 + 0.5) / w, 1.0 - (r as f64 + 0.5) / h);
+            let k = 3 * (r * laid.width as usize + i);
+            assert_eq!(laid.values[k], map.sample(1.5 * u, v)[0]);
+        }
     }
 }

@@ -67,7 +67,9 @@ impl PovMaps {
     /// first use in this session.
     /// A normal map (`kind` Normal) is written as the height field of its
     /// slopes as it lies (`lay`: `pov_bumps`), `scale` its range in
-    /// world length.
+    /// world length. Another map with a sphere's lay is written laid over
+    /// the whole sphere as the normal map's heights are
+    /// (`pov_bumps::over_sphere`), for a spherical image about its centre.
     pub fn get(
         &self,
         t: &TextureRef,
@@ -99,6 +101,10 @@ impl PovMaps {
         }
         let texels = texture::get(Path::new(t.file()), enc)
             .map_err(|e| format!("{}: {}: {e}", kind.key(), t.file()))?;
+        let texels = match lay {
+            Some(pov_bumps::Lay::Sphere { scale, .. }) => pov_bumps::over_sphere(&texels, scale),
+            _ => texels,
+        };
         let values: Vec<f64> = texels
             .values
             .iter()

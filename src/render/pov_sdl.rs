@@ -583,7 +583,7 @@ fn mapped_material(o: &Object, maps: MapSource) -> Result<String, String> {
             .collect();
         Ok(format!(
             "{pre}{}{post} texture_map {{{entries} }}",
-            pattern(&ch.files[0])
+            pattern(&ch.files[0], spherical(o))
         ))
     };
     Ok(match &m.specular_map {
@@ -596,7 +596,7 @@ fn mapped_material(o: &Object, maps: MapSource) -> Result<String, String> {
             let (ch, pre, post) = get(MapKind::Specular, t, None)?;
             format!(
                 "texture {{ {pre}{}{post} texture_map {{ [0 {}] [1 {}] }} }}",
-                pattern(&ch.files[0]),
+                pattern(&ch.files[0], spherical(o)),
                 base(m, 0.0),
                 lit(ch.scale)?
             )
@@ -629,6 +629,7 @@ fn placed(
     t: &TextureRef,
     outer: Option<&TextureRef>,
 ) -> Result<(Arc<Channels>, String, String), String> {
+    let spherical = spherical(o);
     let lay = match k {
         MapKind::Normal => Some(pov_bumps::laid(&o.shape, t.scale()).ok_or_else(|| {
             format!(
@@ -636,21 +637,36 @@ fn placed(
                 o.name
             )
         })?),
+        _ if spherical => pov_bumps::laid(&o.shape, t.scale()),
         _ => None,
     };
     let ch = maps(t, k, lay).map_err(|e| format!("objects.{}.material.{e}", o.name))?;
-    let (pre, mut post) = mapping(&o.shape, t.scale(), k).ok_or_else(|| {
+    let (pre, mut post) = mapping(&o.shape, t.scale(), spherical).ok_or_else(|| {
         format!(
             "objects.{}.material.{}: not drawn on this shape by POV-Ray",
             o.name,
             k.key()
         )
     })?;
-    if let (true, Some(outer)) = (pre.is_empty(), outer) {
-        let (a, b) = (outer.scale(), t.scale());
-        post = format!(" scale <{}, {}, 1>", num(a[0] / b[0]), num(a[1] / b[1]));
+    match (spherical, outer) {
+        // laid over the whole sphere: the enclosing pattern's translation
+        // carries it, and its `scale` is in its texels
+        (true, Some(_)) => post.clear(),
+        (false, Some(outer)) if pre.is_empty() => {
+            let (a, b) = (outer.scale(), t.scale());
+            post = format!(" scale <{}, {}, 1>", num(a[0] / b[0]), num(a[1] / b[1]));
+        }
+        _ => {}
     }
     Ok((ch, pre, post))
+}
+
+/// Whether `o`'s maps are spherical images about its centre: a sphere
+/// with a normal map, whose heights POV-Ray reads only so
+/// (`pov_bumps::sphere_heights`); its other maps are then laid out the
+/// same way (`pov_bumps::over_sphere`) so that the patterns nest.
+fn spherical(o: &Object) -> bool {
+    matches!(o.shape, Shape::Sphere { .. }) && o.material.normal_map.is_some()
 }
 
 /// The pigment of a material with maps: c x the colour map as the
@@ -673,7 +689,7 @@ fn mapped_pigment(
             c[k] = 3.0 * m.color[k] * ch.scale;
             format!(
                 " [1 {pre}{} color_map {{ [0 rgb 0] [1 {}] }}{post}]",
-                pattern(&ch.files[k]),
+                pattern(&ch.files[k], spherical(o)),
                 rgb(c, 1.0)
             )
         })
@@ -699,24 +715,13 @@ fn mapped_normal(
     if ch.scale <= 0.0 {
         return Ok(String::new());
     }
-    // a sphere's heights are a spherical image about its centre (`mapping`)
-    let (image, accuracy) = match o.shape {
-        Shape::Sphere { radius, .. } => {
-            if outer.is_some() {
-                // the scene check's refusal (`maps::povray_refusals`); a guard
-                return Err(format!(
-                    "objects.{}.material.normal_map: on a sphere beside a specular or shininess map, not drawn by POV-Ray",
-                    o.name
-                ));
-            }
-            let image = format!(
-                "image_pattern {{ png \"{}\" gamma 1.0 map_type 1 interpolate 2 }}",
-                ch.files[0]
-            );
-            (image, BUMP_ACCURACY * radius)
-        }
-        _ => (pattern(&ch.files[0]), BUMP_ACCURACY),
+    // a sphere's heights are a spherical image about its centre
+    // (`mapping`): the gradient's step is an angle, so it goes with the radius
+    let accuracy = match o.shape {
+        Shape::Sphere { radius, .. } => BUMP_ACCURACY * radius,
+        _ => BUMP_ACCURACY,
     };
+    let image = pattern(&ch.files[0], spherical(o));
     Ok(format!(
         " normal {{ {pre}{image} bump_size {} accuracy {}{post} }}",
         num(ch.scale / BUMP_GAIN),
@@ -733,24 +738,27 @@ const BUMP_GAIN: f64 = 0.4 / 3.0;
 /// one cell of the height field (`pov_bumps`, at most 1024 a side).
 const BUMP_ACCURACY: f64 = 1e-4;
 
-/// A written map file as a bilinear, linear pattern (`pov_maps`).
-fn pattern(file: &str) -> String {
-    format!("image_pattern {{ png \"{file}\" gamma 1.0 interpolate 2 }}")
+/// A written map file as a bilinear, linear pattern (`pov_maps`), read
+/// as a spherical image (`map_type 1`) when `spherical`.
+fn pattern(file: &str, spherical: bool) -> String {
+    let map_type = if spherical { " map_type 1" } else { "" };
+    format!("image_pattern {{ png \"{file}\" gamma 1.0{map_type} interpolate 2 }}")
 }
 
 /// How a pattern in POV-Ray's image space [0, 1]^2 lands on `shape` at
 /// scenefit's (u, v) x `scale` (docs/scene-format.md "Textures"): what
 /// goes before the pattern and what after. A sphere's and a mesh's
 /// `uv_mapping` are scenefit's (measured: within 0.03 % of phong), but
-/// not for a sphere's normal map (`k`): its heights are laid over the
+/// not for a sphere's normal map: its heights are laid over the
 /// longitude and latitude as POV-Ray's spherical image (`map_type 1`)
 /// reads the direction from the centre (`pov_bumps::sphere_heights`), a
 /// pattern of the point in space whose gradient lies in the surface,
-/// where `uv_mapping` would tilt the normal along the world's axes; a
+/// where `uv_mapping` would tilt the normal along the world's axes; so
+/// every map of such a sphere is (`spherical`: `pov_bumps::over_sphere`); a
 /// plane and a quad are planar maps carried onto their axes (e_u, e_v;
 /// edge_u, edge_v) by a matrix; a box: None (`object` writes a mapped
 /// box as its faces, quads).
-fn mapping(shape: &Shape, scale: [f64; 2], k: MapKind) -> Option<(String, String)> {
+fn mapping(shape: &Shape, scale: [f64; 2], spherical: bool) -> Option<(String, String)> {
     let sc = format!(
         " scale <{}, {}, 1>",
         num(1.0 / scale[0]),
@@ -769,7 +777,7 @@ fn mapping(shape: &Shape, scale: [f64; 2], k: MapKind) -> Option<(String, String
         format!(" matrix <{}>", m.join(", "))
     };
     match *shape {
-        Shape::Sphere { center, .. } if k == MapKind::Normal => {
+        Shape::Sphere { center, .. } if spherical => {
             Some((String::new(), format!(" translate {}", vec(pov(center)))))
         }
         Shape::Sphere { .. } | Shape::Mesh { .. } => Some(("uv_mapping ".into(), sc)),

@@ -73,10 +73,6 @@ fn scene_for(field: &str) -> Scene {
                 file: "m.ply".into(),
             };
         }
-        "a `normal_map` on a `sphere` beside a `specular_map` or `shininess_map`" => {
-            m.normal_map = Some(TextureRef::File("t.png".into()));
-            m.specular_map = Some(TextureRef::File("t.png".into()));
-        }
         "a `normal_map` on a `plane`, `quad`, `box` or `sphere` more than 5 % of whose slopes are not a height field's there" => {
             m.normal_map = Some(TextureRef::File(twisted_normal_map()));
             s.objects[0].shape = unit_quad();
