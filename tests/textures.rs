@@ -523,6 +523,45 @@ fn povray_draws_the_three_maps_together_on_a_quad_and_a_plane() {
     }
 }
 
+/// The materials of the normal-map agreement tests: one with a
+/// highlight, the same with colour, specular and shininess maps, and the
+/// normal map (scenes/textured/bumps.png at scale 2).
+fn normal_map_materials() -> (Value, Value, Value) {
+    let root = common::root().join("scenes/textured");
+    let (checker, stripes) = (root.join("checker.png"), root.join("stripes.png"));
+    let plain = json!({"color": [0.6, 0.6, 0.6], "specular": 0.3, "shininess": 20});
+    let mut all = plain.clone();
+    all["color_map"] = json!({"file": checker, "scale": [1, 1.5]});
+    all["specular_map"] = json!({"file": stripes, "scale": [1, 2]});
+    all["shininess_map"] = json!({"file": stripes, "range": [5, 60], "scale": [3, 1]});
+    let normal = json!({"file": root.join("bumps.png"), "scale": [2, 2]});
+    (plain, all, normal)
+}
+
+/// Asserts POV-Ray's render of `scene(material + normal)` within 1 % of
+/// the built-in tracer's and under a quarter of what the normal map
+/// changes there (`scene(material)` against it).
+fn povray_draws_the_normal_map(
+    name: &str,
+    render: &dyn Fn(&Value, &str) -> Result<Image, String>,
+    scene: &dyn Fn(&Value) -> Value,
+    material: &Value,
+    normal: &Value,
+) {
+    let mut mapped = material.clone();
+    mapped["normal_map"] = normal.clone();
+    let phong = render(&scene(&mapped), "phong").unwrap();
+    let pov = render(&scene(&mapped), "povray").unwrap();
+    let flat = render(&scene(material), "phong").unwrap();
+    let dev = scenefit::metric::deviation(&pov, &phong, None).average;
+    let effect = scenefit::metric::deviation(&flat, &phong, None).average;
+    eprintln!("{name}: POV-Ray {dev:.3} % from phong, the normal map's own effect {effect:.3} %");
+    assert!(
+        dev <= 1.0 && dev < 0.25 * effect,
+        "{name}: {dev:.3} % (the map moves {effect:.3} %)"
+    );
+}
+
 /// POV-Ray draws a normal map on a plane, quad or box (the height field
 /// of its slopes, `render/pov_bumps.rs`; a box face by face) as the
 /// built-in tracer does: on a quad and a box turned and scaled by their
@@ -537,22 +576,11 @@ fn povray_draws_a_normal_map_on_a_quad_a_box_and_a_plane_as_the_built_in_tracer_
         return;
     }
     let d = tempfile::tempdir().unwrap();
-    let root = common::root().join("scenes/textured");
-    let (bumps, checker, stripes) = (
-        root.join("bumps.png"),
-        root.join("checker.png"),
-        root.join("stripes.png"),
-    );
+    let (plain, all, normal) = normal_map_materials();
     let front = json!({"type": "quad", "corner": [-0.9, -0.9, 0], "edge_u": [1.8, 0, 0], "edge_v": [0, 1.8, 0]});
     let turned = json!({"type": "quad", "corner": [-0.8, -0.8, 0.3], "edge_u": [1.5, 0, -0.6], "edge_v": [0, 1.6154, 0]});
     let plane = json!({"type": "plane", "point": [0, -0.5, 0], "normal": [0, 1, 0.4]});
     let cube = json!({"type": "box", "min": [-0.7, -0.7, -0.7], "max": [0.7, 0.7, 0.7]});
-    let normal = json!({"file": bumps, "scale": [2, 2]});
-    let plain = json!({"color": [0.6, 0.6, 0.6], "specular": 0.3, "shininess": 20});
-    let mut all = plain.clone();
-    all["color_map"] = json!({"file": checker, "scale": [1, 1.5]});
-    all["specular_map"] = json!({"file": stripes, "scale": [1, 2]});
-    all["shininess_map"] = json!({"file": stripes, "range": [5, 60], "scale": [3, 1]});
     let scene = |(shape, transform): (&Value, &Value), material: &Value| {
         let mut object = json!({"name": "tile", "shape": shape, "material": material});
         if !transform.is_null() {
@@ -578,23 +606,11 @@ fn povray_draws_a_normal_map_on_a_quad_a_box_and_a_plane_as_the_built_in_tracer_
         ),
         ("tilted plane", (&plane, &none), &plain),
     ] {
-        let mut mapped = material.clone();
-        mapped["normal_map"] = normal.clone();
-        let phong = render(&scene(shape, &mapped), "phong").unwrap();
-        let pov = render(&scene(shape, &mapped), "povray").unwrap();
-        let flat = render(&scene(shape, material), "phong").unwrap();
-        let dev = scenefit::metric::deviation(&pov, &phong, None).average;
-        let effect = scenefit::metric::deviation(&flat, &phong, None).average;
-        eprintln!(
-            "{name}: POV-Ray {dev:.3} % from phong, the normal map's own effect {effect:.3} %"
-        );
-        assert!(
-            dev <= 1.0 && dev < 0.25 * effect,
-            "{name}: {dev:.3} % (the map moves {effect:.3} %)"
-        );
+        let scene = |material: &Value| scene(shape, material);
+        povray_draws_the_normal_map(name, &render, &scene, material, &normal);
     }
     let mut stretched = plain.clone();
-    stretched["normal_map"] = json!({"file": bumps, "scale": [1, 3]});
+    stretched["normal_map"] = json!({"file": normal["file"], "scale": [1, 3]});
     let refused = match render(&scene((&front, &none), &stretched), "povray") {
         Ok(_) => panic!("a stretched normal map was drawn"),
         Err(e) => e.to_string(),
@@ -692,6 +708,82 @@ fn povray_draws_a_normal_map_made_for_a_sphere_as_the_built_in_tracer_does() {
     flat_tile["normal_map"] = json!({"file": textured.join("bumps.png"), "scale": [6, 3]});
     let why = refused(flat_tile);
     assert!(why.contains("height field"), "{why}");
+}
+
+/// A bent strip (OBJ, 16 triangles with vertex normals): an arc about
+/// the y axis, its texture coordinates its angle and height.
+fn bent_strip(dir: &Path) -> std::path::PathBuf {
+    let mut obj = String::new();
+    for a in 0..=8 {
+        let angle = (-60.0 + 15.0 * a as f64).to_radians();
+        let (x, z) = (angle.sin(), angle.cos() - 0.6);
+        for y in [-0.8, 0.8] {
+            obj += &format!(
+                "v {x} {y} {z}\nvt {} {}\nvn {} 0 {}\n",
+                a as f64 / 8.0,
+                (y + 0.8) / 1.6,
+                angle.sin(),
+                angle.cos()
+            );
+        }
+    }
+    for a in 0..8 {
+        let (p, q) = (2 * a + 1, 2 * a + 3);
+        obj += &format!("f {p}/{p}/{p} {q}/{q}/{q} {}/{}/{}\n", q + 1, q + 1, q + 1);
+        obj += &format!(
+            "f {p}/{p}/{p} {}/{}/{} {}/{}/{}\n",
+            q + 1,
+            q + 1,
+            q + 1,
+            p + 1,
+            p + 1,
+            p + 1
+        );
+    }
+    let path = dir.join("bent.obj");
+    std::fs::write(&path, obj).unwrap();
+    path
+}
+
+/// POV-Ray draws a normal map on a mesh (its triangles cut finer, each
+/// corner's normal the map's: `pov_mesh_bumps`) as the built-in tracer
+/// does: on a flat mesh without vertex normals, on a bent one with them,
+/// on the flat one turned and scaled unevenly by its transform, and
+/// beside colour, specular and shininess maps; within 1 % over the image
+/// and within a quarter of what the normal map itself changes.
+#[test]
+fn povray_draws_a_normal_map_on_a_mesh_as_the_built_in_tracer_does() {
+    if !common::have("povray", "POV-Ray") {
+        return;
+    }
+    let d = tempfile::tempdir().unwrap();
+    let (plain, all, normal) = normal_map_materials();
+    let square = d.path().join("square.obj");
+    std::fs::write(
+        &square,
+        "v -0.9 -0.9 0\nv 0.9 -0.9 0\nv 0.9 0.9 0\nv -0.9 0.9 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nf 1/1 2/2 3/3\nf 1/1 3/3 4/4\n",
+    )
+    .unwrap();
+    let flat = json!({"type": "mesh", "file": square});
+    let bent = json!({"type": "mesh", "file": bent_strip(d.path())});
+    let uneven = json!({"rotate_deg": [20, 30, 0], "scale": [1.1, 0.7, 1.0]});
+    let none = Value::Null;
+    let render = |s: &Value, backend: &str| render_in(d.path(), s, backend);
+    for (name, shape, transform, material) in [
+        ("flat, no vertex normals", &flat, &none, &plain),
+        ("bent, vertex normals", &bent, &none, &plain),
+        ("flat, turned and scaled unevenly", &flat, &uneven, &plain),
+        ("bent, three maps besides", &bent, &none, &all),
+    ] {
+        let scene = |material: &Value| {
+            let mut o = json!({"name": "sheet", "shape": shape, "material": material});
+            if !transform.is_null() {
+                o["transform"] = transform.clone();
+            }
+            tile_scene(o, [0.8, 0.6, 2.0])
+        };
+        povray_draws_the_normal_map(name, &render, &scene, material, &normal);
+    }
 }
 
 /// Mitsuba (`normalmap` BSDF) and Blender (Normal Map node) draw the

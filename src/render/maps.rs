@@ -13,8 +13,8 @@ pub const PHONG: &[MapKind] = ALL_MAPS;
 pub const BLENDER: &[MapKind] = ALL_MAPS;
 pub const MITSUBA: &[MapKind] = ALL_MAPS;
 
-/// The maps POV-Ray draws: all four, the normal map on a plane, quad,
-/// box or sphere only (`povray_refusals`).
+/// The maps POV-Ray draws: all four, the normal map where a height field
+/// has its slopes or on a mesh (`povray_refusals`).
 pub const POVRAY: &[MapKind] = ALL_MAPS;
 
 /// Every map refusal of the Blender worker (`mitsuba` false) or the
@@ -34,8 +34,9 @@ pub fn worker_refusals(scene: &Scene, mitsuba: bool) -> Vec<Refusal> {
 /// Every map refusal of POV-Ray: the maps it does not draw, and what it
 /// does not draw them on: glass, a specular or shininess map beside
 /// `specular2` (each is a patterned texture, and POV-Ray layers nothing
-/// over one), a normal map on a mesh, or one whose slopes are no height
-/// field's on one of its surfaces (a box's are its six faces).
+/// over one), or a normal map whose slopes are no height field's on one
+/// of its surfaces (a box's are its six faces; a mesh's is baked into its
+/// normals, `pov_mesh_bumps`, and drawn whatever it holds).
 pub fn povray_refusals(scene: &Scene) -> Vec<Refusal> {
     let mut out = refusals(scene, "povray", POVRAY);
     out.extend(limits(scene));
@@ -71,12 +72,6 @@ pub fn povray_refusals(scene: &Scene) -> Vec<Refusal> {
             out.push(Refusal::new(
                 format!("objects.{}.transform.scale", o.name),
                 "a normal_map on an object scaled unevenly is not drawn by povray (it turns the height's gradient as a normal, the built-in tracer turns the map's frame); use phong, blender or mitsuba, or scale the shape itself",
-            ));
-        }
-        if m.normal_map.is_some() && lays.is_none() {
-            out.push(Refusal::new(
-                format!("objects.{}.material.normal_map", o.name),
-                "a normal_map is drawn by povray on a plane, quad, box or sphere only (its normal is a height field's gradient, and on a mesh POV-Ray's uv_mapping tilts the normal along the world's axes, not the surface's); use phong, blender or mitsuba",
             ));
         }
         let patterned = m.specular_map.is_some() || m.shininess_map.is_some();

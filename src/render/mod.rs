@@ -19,6 +19,7 @@ pub mod near_lights;
 pub mod pbr_fields;
 pub mod pov_bumps;
 pub mod pov_maps;
+pub mod pov_mesh_bumps;
 pub mod pov_sdl;
 pub mod povray;
 mod recent;

@@ -14,6 +14,8 @@
 //! part of another that no height field has (a twist of the normals, a
 //! tilt of the whole tile, a flat tile's map wrapped on a sphere, whose
 //! east steps shrink towards the poles) is lost, which the solve reports.
+//! A sphere's other maps are laid over it the same way (`over_sphere`), so
+//! that all its patterns are one spherical image and nest.
 //!
 //! The height is laid out `FINE` times finer than the map: POV-Ray's
 //! bilinear pattern has a slope that is constant across each cell, where
@@ -284,7 +286,8 @@ fn gradient(texels: &Texels, [lo, hi]: [f64; 2], s: f64, t: f64) -> (f64, f64) {
 }
 
 /// Most texels a side of a map laid over a sphere (`over_sphere`): 200 MB
-/// of colour at most.
+/// of colour at most, and `pov_maps::get` holds it again in f64 while it
+/// writes the channels (400 MB more: 600 MB at the peak).
 const MAX_LAID: u32 = 4096;
 
 /// The map `texels` repeated `scale` times around and up a sphere, laid

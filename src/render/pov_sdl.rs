@@ -25,7 +25,8 @@
 //!   oriented `area_light` of diameter 2r (9x9). `directional` -> a
 //!   `parallel` light 1e6 m away along `direction`, colour E*color.
 //! - objects: `sphere`, `plane`, `quad` (`polygon`), `box`, `mesh`
-//!   (`mesh2`, with `normal_vectors` when the file has vertex normals); an
+//!   (`mesh2`, with `normal_vectors` when the file has vertex normals; a
+//!   normal-mapped mesh cut finer, its normals the map's: `pov_mesh_bumps`); an
 //!   object's `transform` after the shape as `scale`, `rotate`, `translate`
 //!   (see `placement`).
 //! - names: never written (comments say `lights[i]`, `objects[i]`): the
@@ -296,7 +297,12 @@ fn shape_of(o: &Object, mapped: bool) -> Result<String, String> {
         Shape::Mesh { ref file } => {
             let m = crate::scene::mesh::get(std::path::Path::new(file))
                 .map_err(|e| format!("objects.{}.shape.file: {e}", o.name))?;
-            mesh2(&m, mapped)
+            if o.material.normal_map.is_some() {
+                // its normal map is in its normals (`pov_mesh_bumps`)
+                mesh2(&super::pov_mesh_bumps::baked(o, &m)?, mapped)
+            } else {
+                mesh2(&m, mapped)
+            }
         }
     })
 }
@@ -711,6 +717,10 @@ fn mapped_normal(
     let Some(t) = &o.material.normal_map else {
         return Ok(String::new());
     };
+    if matches!(o.shape, Shape::Mesh { .. }) {
+        // a mesh's is in its normals (`shape_of`, `pov_mesh_bumps`)
+        return Ok(String::new());
+    }
     let (ch, pre, post) = placed(o, maps, MapKind::Normal, t, outer)?;
     if ch.scale <= 0.0 {
         return Ok(String::new());

@@ -67,12 +67,6 @@ fn scene_for(field: &str) -> Scene {
             s.objects[0].transform =
                 serde_json::from_value(serde_json::json!({"scale": [1.0, 2.0, 1.0]})).unwrap();
         }
-        "`material.normal_map` on a `mesh`" => {
-            m.normal_map = Some(TextureRef::File("t.png".into()));
-            s.objects[0].shape = crate::scene::Shape::Mesh {
-                file: "m.ply".into(),
-            };
-        }
         "a `normal_map` on a `plane`, `quad`, `box` or `sphere` more than 5 % of whose slopes are not a height field's there" => {
             m.normal_map = Some(TextureRef::File(twisted_normal_map()));
             s.objects[0].shape = unit_quad();

@@ -113,6 +113,13 @@ impl Affine {
     pub fn normal(&self, n: V3) -> V3 {
         V3::new(self.n[0].dot(n), self.n[1].dot(n), self.n[2].dot(n))
     }
+
+    /// The object-frame normal that [`Affine::normal`] carries to the
+    /// direction of `n` (M^T n): for a renderer that transforms normals
+    /// itself but must show one worked out in the world.
+    pub fn normal_back(&self, n: V3) -> V3 {
+        self.m[0] * n.x + self.m[1] * n.y + self.m[2] * n.z
+    }
 }
 
 /// The rotation by `a` radians about world axis `axis`, as rows.

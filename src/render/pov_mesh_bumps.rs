@@ -1,0 +1,280 @@
+//! A normal-mapped mesh as POV-Ray can draw it: the mesh cut into
+//! smaller triangles, each corner given the normal the map makes there,
+//! which POV-Ray interpolates across each small triangle as it does any
+//! `mesh2`'s `normal_vectors`. POV-Ray's own bump patterns cannot do it:
+//! on a mesh its `uv_mapping` turns a pattern's gradient along the
+//! world's axes, not the surface's.
+//!
+//! The built-in tracer interpolates the map's texels at each hit and then
+//! perturbs (`scene::texture::tangent::perturbed`); here the perturbed
+//! normals are interpolated, which is the same once the small triangles
+//! are a fraction of a texel (`FINE` a texel along their edges). The
+//! normal is worked out in the world, as the built-in tracer does (the
+//! map's frame turned by the object's transform, so an uneven scale is
+//! drawn too), and written back in the mesh's frame (`Affine::normal_back`)
+//! for POV-Ray to carry through the same transform.
+
+use crate::math::V3;
+use crate::scene::mesh::Mesh;
+use crate::scene::texture::tangent::{self, Tangents};
+use crate::scene::texture::{self, MapKind, Texels, TextureRef};
+use crate::scene::transform::Affine;
+use crate::scene::Object;
+use std::path::Path;
+
+/// Small triangles per texel along each edge.
+const FINE: f64 = 2.0;
+
+/// The most triangles a baked mesh has (about 40 bytes of `mesh2` text
+/// each and 80 of memory while it is written): a finer map over a larger
+/// mesh is cut more coarsely, evenly, and drawn less exactly.
+pub const MAX_TRIANGLES: usize = 1 << 19;
+
+/// `mesh` (the object `o`'s, which has a normal map) cut and given the
+/// map's normals, with its texture coordinates; the mesh itself when it
+/// has no texture coordinates (the map then changes nothing, as in the
+/// built-in tracer).
+pub fn baked(o: &Object, mesh: &Mesh) -> Result<Mesh, String> {
+    let Some(t) = o.material.map(MapKind::Normal) else {
+        return Ok(mesh.clone());
+    };
+    if mesh.texcoords.is_empty() {
+        return Ok(mesh.clone());
+    }
+    let texels = texture::get(Path::new(t.file()), t.encoding(MapKind::Normal))
+        .map_err(|e| format!("objects.{}.material.normal_map: {}: {e}", o.name, t.file()))?;
+    let affine = o.transform.as_ref().map(Affine::new);
+    let cuts = cuts(mesh, t, &texels);
+    let mut out = Mesh {
+        positions: Vec::new(),
+        normals: Vec::new(),
+        texcoords: Vec::new(),
+        triangles: Vec::new(),
+    };
+    for (tri, &k) in cuts.iter().enumerate() {
+        cut(mesh, tri, k, &mut out, |uv, frame| {
+            normal(frame, affine.as_ref(), map_value(t, &texels, uv))
+        });
+    }
+    Ok(out)
+}
+
+/// The map's value at texture coordinates `uv`, after its `scale` and
+/// `range`, as the built-in tracer reads it.
+fn map_value(t: &TextureRef, texels: &Texels, uv: [f64; 2]) -> [f32; 3] {
+    let [s0, s1] = t.scale();
+    let [lo, hi] = t.range().map(|x| x as f32);
+    texels
+        .sample(uv[0] * s0, uv[1] * s1)
+        .map(|x| lo + x * (hi - lo))
+}
+
+/// The normal, in the mesh's frame, that the texel `rgb` gives where the
+/// surface's frame (mesh's frame) is `frame`.
+fn normal(frame: Tangents, affine: Option<&Affine>, rgb: [f32; 3]) -> V3 {
+    let world = match affine {
+        Some(a) => Tangents {
+            du: a.vector(frame.du),
+            dv: a.vector(frame.dv),
+            n: a.normal(frame.n),
+        },
+        None => frame,
+    };
+    let n = world.n.normalized();
+    let p = tangent::perturbed(n, &world, rgb);
+    match affine {
+        Some(a) => a.normal_back(p),
+        None => p,
+    }
+}
+
+/// How many parts each triangle's edges are cut into: `FINE` a texel
+/// along its longest edge, fewer (evenly) when the whole would pass
+/// `MAX_TRIANGLES`.
+fn cuts(mesh: &Mesh, t: &TextureRef, texels: &Texels) -> Vec<u32> {
+    let [s0, s1] = t.scale();
+    let (w, h) = (texels.width as f64 * s0, texels.height as f64 * s1);
+    let want: Vec<f64> = (mesh.triangles.iter())
+        .map(|tri| {
+            let uv = |k: usize| mesh.texcoords[tri[k] as usize];
+            let texels = |a: [f64; 2], b: [f64; 2]| ((a[0] - b[0]) * w).hypot((a[1] - b[1]) * h);
+            let (a, b, c) = (uv(0), uv(1), uv(2));
+            let longest = texels(a, b).max(texels(b, c)).max(texels(c, a));
+            // a non-finite or huge edge is capped: the budget decides
+            (FINE * longest).clamp(1.0, 1e6)
+        })
+        .collect();
+    let total: f64 = want.iter().map(|k| k.ceil() * k.ceil()).sum();
+    if total <= MAX_TRIANGLES as f64 {
+        return want.iter().map(|k| k.ceil() as u32).collect();
+    }
+    // floor(k s)^2 summed is at most s^2 times the total: the budget
+    let shrink = (MAX_TRIANGLES as f64 / total).sqrt();
+    want.iter()
+        .map(|k| ((k * shrink).floor() as u32).max(1))
+        .collect()
+}
+
+/// Triangle `tri` of `mesh` cut into k x k triangles (its winding kept),
+/// appended to `out`, each corner's normal `normal_at(uv, frame)`.
+/// Corners on an edge are computed from the edge's two ends in the order
+/// of their indices, so that the two triangles sharing it meet exactly.
+fn cut(
+    mesh: &Mesh,
+    tri: usize,
+    k: u32,
+    out: &mut Mesh,
+    normal_at: impl Fn([f64; 2], Tangents) -> V3,
+) {
+    let t = mesh.triangles[tri];
+    let mut order = [0usize, 1, 2];
+    order.sort_by_key(|&c| t[c]);
+    let base = out.positions.len() as u32;
+    let kf = k as f64;
+    for j in 0..=k {
+        for i in 0..=k - j {
+            let w = [(k - i - j) as f64 / kf, i as f64 / kf, j as f64 / kf];
+            let mut p = [0.0; 3];
+            let mut uv = [0.0; 2];
+            for &c in &order {
+                let v = t[c] as usize;
+                for (a, x) in p.iter_mut().zip(mesh.positions[v]) {
+                    *a += w[c] * x;
+                }
+                for (a, x) in uv.iter_mut().zip(mesh.texcoords[v]) {
+                    *a += w[c] * x;
+                }
+            }
+            let frame = tangent::mesh_tangents(mesh, tri, w[1], w[2])
+                .expect("the mesh has texture coordinates");
+            let n = normal_at(uv, frame);
+            out.positions.push(p);
+            out.texcoords.push(uv);
+            out.normals.push([n.x, n.y, n.z]);
+        }
+    }
+    // corner (i, j) of row j: rows hold k + 1, k, ..., 1 corners
+    let at = |i: u32, j: u32| base + j * (k + 1) - j * j.saturating_sub(1) / 2 + i;
+    for j in 0..k {
+        for i in 0..k - j {
+            out.triangles.push([at(i, j), at(i + 1, j), at(i, j + 1)]);
+            if i + j + 1 < k {
+                out.triangles
+                    .push([at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)]);
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn square() -> Mesh {
+        Mesh {
+            positions: vec![
+                [0.0, 0.0, 0.0],
+                [1.0, 0.0, 0.0],
+                [1.0, 1.0, 0.0],
+                [0.0, 1.0, 0.0],
+            ],
+            normals: vec![],
+            texcoords: vec![[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]],
+            triangles: vec![[0, 1, 2], [0, 2, 3]],
+        }
+    }
+
+    /// Cut k x k, a triangle keeps its area, winding and texture
+    /// coordinates, and its corners on a shared edge are the
+    /// neighbour's, to the bit.
+    #[test]
+    fn a_cut_triangle_keeps_its_area_and_meets_its_neighbour_exactly() {
+        let m = square();
+        for k in [1, 2, 3, 7] {
+            let mut out = Mesh {
+                positions: vec![],
+                normals: vec![],
+                texcoords: vec![],
+                triangles: vec![],
+            };
+            for tri in 0..2 {
+                cut(&m, tri, k, &mut out, |_, f| f.n);
+            }
+            assert_eq!(out.triangles.len(), 2 * (k * k) as usize);
+            let p = |i: u32| V3::from(out.positions[i as usize]);
+            let area: f64 = (out.triangles.iter())
+                .map(|t| (p(t[1]) - p(t[0])).cross(p(t[2]) - p(t[0])).z / 2.0)
+                .sum();
+            // every small triangle wound as its parent (+z)
+            assert!((area - 1.0).abs() < 1e-12, "k {k}: area {area}");
+            assert!(out
+                .triangles
+                .iter()
+                .all(|t| { (p(t[1]) - p(t[0])).cross(p(t[2]) - p(t[0])).z > 0.0 }));
+            // uv = (x, y) on this square
+            for (q, uv) in out.positions.iter().zip(&out.texcoords) {
+                assert!((q[0] - uv[0]).abs() < 1e-12 && (q[1] - uv[1]).abs() < 1e-12);
+            }
+            // the diagonal's corners: each appears once from each side
+            let diagonal: Vec<_> = (out.positions.iter()).filter(|q| q[0] == q[1]).collect();
+            assert_eq!(diagonal.len(), 2 * (k as usize + 1), "k {k}");
+            for q in &diagonal {
+                assert_eq!(diagonal.iter().filter(|r| r == &q).count(), 2, "{q:?}");
+            }
+        }
+    }
+
+    /// Each triangle is cut `FINE` a texel along its longest edge; over
+    /// the budget, fewer, and the whole within it.
+    #[test]
+    fn the_cuts_follow_the_texels_within_the_budget() {
+        let m = square();
+        let small = Texels {
+            width: 8,
+            height: 8,
+            values: vec![0.5; 8 * 8 * 3],
+        };
+        let t = TextureRef::File("t.png".into());
+        // the diagonal is 8 sqrt 2 texels: 2 x 11.3 -> 23
+        assert_eq!(cuts(&m, &t, &small), vec![23, 23]);
+        let huge = Texels {
+            width: 4096,
+            height: 4096,
+            values: vec![],
+        };
+        let k = cuts(&m, &t, &huge);
+        let total: u64 = k.iter().map(|&k| (k as u64).pow(2)).sum();
+        assert!(
+            total <= MAX_TRIANGLES as u64 && total > MAX_TRIANGLES as u64 / 2,
+            "{k:?}"
+        );
+    }
+
+    /// A flat texel keeps the surface's normal; a tilted one tilts it
+    /// along dP/du in the world, and an uneven scale is undone by
+    /// `normal_back` as POV-Ray's transform of a normal does it.
+    #[test]
+    fn the_normal_is_the_maps_in_the_world_written_in_the_mesh_frame() {
+        let frame = Tangents {
+            du: V3::new(1.0, 0.0, 0.0),
+            dv: V3::new(0.0, 1.0, 0.0),
+            n: V3::new(0.0, 0.0, 1.0),
+        };
+        let flat = normal(frame, None, [0.5, 0.5, 1.0]);
+        assert!((flat - frame.n).length() < 1e-12);
+        let tr: crate::scene::transform::Transform = serde_json::from_value(
+            serde_json::json!({"scale": [2.0, 1.0, 0.5], "rotate_deg": [0.0, 0.0, 30.0]}),
+        )
+        .unwrap();
+        let a = Affine::new(&tr);
+        let back = normal(frame, Some(&a), [1.0, 0.5, 1.0]);
+        // carried as POV-Ray carries a normal: the world's 45-degree tilt
+        let world = a.normal(back).normalized();
+        let (du, n) = (
+            a.vector(frame.du).normalized(),
+            a.normal(frame.n).normalized(),
+        );
+        let s = 0.5f64.sqrt();
+        assert!((world - (du * s + n * s)).length() < 1e-9, "{world:?}");
+    }
+}
