@@ -12,15 +12,18 @@
 //! normal is worked out in the world, as the built-in tracer does (the
 //! map's frame turned by the object's transform, so an uneven scale is
 //! drawn too), and written back in the mesh's frame (`Affine::normal_back`)
-//! for POV-Ray to carry through the same transform.
+//! for POV-Ray to carry through the same transform. The written text of
+//! the last two is kept (`written`): a fit redraws the same one.
 
+use super::recent::Recent;
 use crate::math::V3;
 use crate::scene::mesh::Mesh;
 use crate::scene::texture::tangent::{self, Tangents};
 use crate::scene::texture::{self, MapKind, Texels, TextureRef};
-use crate::scene::transform::Affine;
-use crate::scene::Object;
+use crate::scene::transform::{Affine, Transform};
+use crate::scene::{Object, Shape};
 use std::path::Path;
+use std::sync::Arc;
 
 /// Small triangles per texel along each edge.
 const FINE: f64 = 2.0;
@@ -30,11 +33,35 @@ const FINE: f64 = 2.0;
 /// mesh is cut more coarsely, evenly, and drawn less exactly.
 pub const MAX_TRIANGLES: usize = 1 << 19;
 
+/// What a baked mesh is made of: the mesh's file, its normal map, its
+/// transform.
+type Key = (String, TextureRef, Option<Transform>);
+
+/// The last baked meshes as written (`mesh2` text), by what they are made
+/// of: a fit renders the same mesh under the same map on every candidate,
+/// and at the budget the cut and its text take over a second. Two kept:
+/// a few tens of MB each at most.
+static WRITTEN: Recent<Key, Arc<str>> = Recent::new(2);
+
+/// The object `o`'s mesh `mesh` (it has a normal map) baked (`baked`) and
+/// written by `write`, or the text kept from a render before.
+pub fn written(
+    o: &Object,
+    mesh: &Mesh,
+    write: impl FnOnce(&Mesh) -> String,
+) -> Result<Arc<str>, String> {
+    let (Shape::Mesh { file }, Some(t)) = (&o.shape, o.material.map(MapKind::Normal)) else {
+        return Ok(write(mesh).into());
+    };
+    let key = (file.clone(), t.clone(), o.transform.clone());
+    WRITTEN.get_or(key, || Ok(write(&baked(o, mesh)?).into()))
+}
+
 /// `mesh` (the object `o`'s, which has a normal map) cut and given the
 /// map's normals, with its texture coordinates; the mesh itself when it
 /// has no texture coordinates (the map then changes nothing, as in the
 /// built-in tracer).
-pub fn baked(o: &Object, mesh: &Mesh) -> Result<Mesh, String> {
+fn baked(o: &Object, mesh: &Mesh) -> Result<Mesh, String> {
     let Some(t) = o.material.map(MapKind::Normal) else {
         return Ok(mesh.clone());
     };

@@ -299,7 +299,7 @@ fn shape_of(o: &Object, mapped: bool) -> Result<String, String> {
                 .map_err(|e| format!("objects.{}.shape.file: {e}", o.name))?;
             if o.material.normal_map.is_some() {
                 // its normal map is in its normals (`pov_mesh_bumps`)
-                mesh2(&super::pov_mesh_bumps::baked(o, &m)?, mapped)
+                super::pov_mesh_bumps::written(o, &m, |b| mesh2(b, mapped))?.to_string()
             } else {
                 mesh2(&m, mapped)
             }
