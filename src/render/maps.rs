@@ -13,8 +13,8 @@ pub const PHONG: &[MapKind] = ALL_MAPS;
 pub const BLENDER: &[MapKind] = ALL_MAPS;
 pub const MITSUBA: &[MapKind] = ALL_MAPS;
 
-/// The maps POV-Ray draws: all four, the normal map where a height field
-/// has its slopes or on a mesh (`povray_refusals`).
+/// The maps POV-Ray draws: all four, a plane's normal map only where a
+/// height field has its slopes (`povray_refusals`).
 pub const POVRAY: &[MapKind] = ALL_MAPS;
 
 /// Every map refusal of the Blender worker (`mitsuba` false) or the
@@ -34,15 +34,18 @@ pub fn worker_refusals(scene: &Scene, mitsuba: bool) -> Vec<Refusal> {
 /// Every map refusal of POV-Ray: the maps it does not draw, and what it
 /// does not draw them on: glass, a specular or shininess map beside
 /// `specular2` (each is a patterned texture, and POV-Ray layers nothing
-/// over one), or a normal map whose slopes are no height field's on one
-/// of its surfaces (a box's are its six faces; a mesh's is baked into its
-/// normals, `pov_mesh_bumps`, and drawn whatever it holds).
+/// over one), or a plane's normal map whose slopes are no height
+/// field's there or whose transform scales unevenly (a mesh's, and such a
+/// sphere's, quad's or box's, is baked into a mesh's normals,
+/// `pov_mesh_bumps`, and drawn whatever it holds).
 pub fn povray_refusals(scene: &Scene) -> Vec<Refusal> {
     let mut out = refusals(scene, "povray", POVRAY);
     out.extend(limits(scene));
     for o in &scene.objects {
         let m = &o.material;
-        let lays = m.normal_map.as_ref().and_then(|t| {
+        // what POV-Ray cannot draw as a height field it bakes, but on a plane
+        let baked = super::pov_mesh_bumps::bakes(o);
+        let lays = m.normal_map.as_ref().filter(|_| !baked).and_then(|t| {
             let faces = o.shape.faces();
             let lays: Option<Vec<_>> = faces
                 .iter()
@@ -64,11 +67,7 @@ pub fn povray_refusals(scene: &Scene) -> Vec<Refusal> {
                 ));
             }
         }
-        let uneven = o.transform.as_ref().and_then(|t| t.scale).is_some_and(|s| {
-            let [a, b, c] = s.axes();
-            (a - b).abs() > 1e-9 * a.abs() || (a - c).abs() > 1e-9 * a.abs()
-        });
-        if lays.is_some() && uneven {
+        if lays.is_some() && super::pov_mesh_bumps::scaled_unevenly(o) {
             out.push(Refusal::new(
                 format!("objects.{}.transform.scale", o.name),
                 "a normal_map on an object scaled unevenly is not drawn by povray (it turns the height's gradient as a normal, the built-in tracer turns the map's frame); use phong, blender or mitsuba, or scale the shape itself",

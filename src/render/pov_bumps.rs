@@ -13,7 +13,8 @@
 //! height field's (bumps, grain, a scan's relief) is drawn as given; the
 //! part of another that no height field has (a twist of the normals, a
 //! tilt of the whole tile, a flat tile's map wrapped on a sphere, whose
-//! east steps shrink towards the poles) is lost, which the solve reports.
+//! east steps shrink towards the poles) is lost, which the solve reports;
+//! such a map is then baked into a mesh (`pov_mesh_bumps`), but on a plane.
 //! A sphere's other maps are laid over it the same way (`over_sphere`), so
 //! that all its patterns are one spherical image and nest.
 //!

@@ -3,7 +3,9 @@
 //! which POV-Ray interpolates across each small triangle as it does any
 //! `mesh2`'s `normal_vectors`. POV-Ray's own bump patterns cannot do it:
 //! on a mesh its `uv_mapping` turns a pattern's gradient along the
-//! world's axes, not the surface's.
+//! world's axes, not the surface's. A sphere, quad or box whose map is no
+//! height field's (`pov_bumps`) is made triangles and baked the same way
+//! (`bakes`); a plane has no end to cut.
 //!
 //! The built-in tracer interpolates the map's texels at each hit and then
 //! perturbs (`scene::texture::tangent::perturbed`); here the perturbed
@@ -33,9 +35,9 @@ const FINE: f64 = 2.0;
 /// mesh is cut more coarsely, evenly, and drawn less exactly.
 pub const MAX_TRIANGLES: usize = 1 << 19;
 
-/// What a baked mesh is made of: the mesh's file, its normal map, its
-/// transform.
-type Key = (String, TextureRef, Option<Transform>);
+/// What a baked mesh is made of: the shape (a mesh's file), its normal
+/// map, its transform.
+type Key = (Shape, TextureRef, Option<Transform>);
 
 /// The last baked meshes as written (`mesh2` text), by what they are made
 /// of: a fit renders the same mesh under the same map on every candidate,
@@ -43,18 +45,128 @@ type Key = (String, TextureRef, Option<Transform>);
 /// a few tens of MB each at most.
 static WRITTEN: Recent<Key, Arc<str>> = Recent::new(2);
 
-/// The object `o`'s mesh `mesh` (it has a normal map) baked (`baked`) and
-/// written by `write`, or the text kept from a render before.
-pub fn written(
-    o: &Object,
-    mesh: &Mesh,
-    write: impl FnOnce(&Mesh) -> String,
-) -> Result<Arc<str>, String> {
-    let (Shape::Mesh { file }, Some(t)) = (&o.shape, o.material.map(MapKind::Normal)) else {
-        return Ok(write(mesh).into());
+/// Whether POV-Ray draws `o`'s normal map baked into a mesh: a mesh's
+/// always; a sphere's, quad's or box's where it cannot draw it as a
+/// height field's gradient (`pov_bumps`): the slopes no height's on a
+/// face (`pov_bumps::refused`), or the object scaled unevenly (POV-Ray
+/// would turn the gradient as a normal, the built-in tracer turns the
+/// map's frame). Never a plane's: it has no end to cut. An unreadable
+/// map is not baked (the scene check reports it).
+pub fn bakes(o: &Object) -> bool {
+    let Some(t) = o.material.map(MapKind::Normal) else {
+        return false;
     };
-    let key = (file.clone(), t.clone(), o.transform.clone());
-    WRITTEN.get_or(key, || Ok(write(&baked(o, mesh)?).into()))
+    match o.shape {
+        Shape::Mesh { .. } => true,
+        Shape::Plane { .. } => false,
+        _ => {
+            scaled_unevenly(o)
+                || o.shape.faces().iter().any(|f| {
+                    super::pov_bumps::laid(f, t.scale())
+                        .is_some_and(|lay| matches!(super::pov_bumps::missed(t, lay), Ok(Some(_))))
+                })
+        }
+    }
+}
+
+/// Whether `o`'s transform scales its axes differently.
+pub fn scaled_unevenly(o: &Object) -> bool {
+    o.transform.as_ref().and_then(|t| t.scale).is_some_and(|s| {
+        let [a, b, c] = s.axes();
+        (a - b).abs() > 1e-9 * a.abs() || (a - c).abs() > 1e-9 * a.abs()
+    })
+}
+
+/// The object `o` (`bakes`) as a mesh baked with its normal map and
+/// written by `write`, or the text kept from a render before.
+pub fn written(o: &Object, write: impl FnOnce(&Mesh) -> String) -> Result<Arc<str>, String> {
+    let t = o.material.map(MapKind::Normal);
+    let t = t.ok_or_else(|| format!("objects.{}.material.normal_map: none to bake", o.name))?;
+    let key = (o.shape.clone(), t.clone(), o.transform.clone());
+    WRITTEN.get_or(key, || {
+        let mesh = match &o.shape {
+            Shape::Mesh { file } => crate::scene::mesh::get(Path::new(file))
+                .map_err(|e| format!("objects.{}.shape.file: {e}", o.name))?,
+            shape => Arc::new(tessellated(shape).ok_or_else(|| {
+                format!(
+                    "objects.{}.material.normal_map: a plane is not baked",
+                    o.name
+                )
+            })?),
+        };
+        Ok(write(&baked(o, &mesh)?).into())
+    })
+}
+
+/// Rows and columns of a sphere's grid of longitude and latitude: its
+/// silhouette is then within 8e-5 of its radius; the bake cuts finer.
+const SPHERE_GRID: [u32; 2] = [256, 128];
+
+/// A sphere, quad or box as triangles in its own frame, with its texture
+/// coordinates (`texture::uv`) and outward normals; None for a plane or a
+/// mesh.
+fn tessellated(shape: &Shape) -> Option<Mesh> {
+    let mut m = Mesh {
+        positions: Vec::new(),
+        normals: Vec::new(),
+        texcoords: Vec::new(),
+        triangles: Vec::new(),
+    };
+    match *shape {
+        Shape::Sphere { center, radius } => {
+            let [nu, nv] = SPHERE_GRID;
+            for j in 0..=nv {
+                let lat = std::f64::consts::PI * (j as f64 / nv as f64 - 0.5);
+                for i in 0..=nu {
+                    let lon = 2.0 * std::f64::consts::PI * i as f64 / nu as f64;
+                    // texture::uv::sphere_uv: u = atan2(-z, x) / 2 pi, v = 1/2 + lat / pi
+                    let d = [lon.cos() * lat.cos(), lat.sin(), -lon.sin() * lat.cos()];
+                    m.positions
+                        .push([0, 1, 2].map(|k| center[k] + radius * d[k]));
+                    m.normals.push(d);
+                    m.texcoords
+                        .push([i as f64 / nu as f64, j as f64 / nv as f64]);
+                }
+            }
+            let at = |i: u32, j: u32| j * (nu + 1) + i;
+            for j in 0..nv {
+                for i in 0..nu {
+                    // a pole's row keeps only the triangle with area
+                    if j > 0 {
+                        m.triangles.push([at(i, j), at(i + 1, j), at(i + 1, j + 1)]);
+                    }
+                    if j + 1 < nv {
+                        m.triangles.push([at(i, j), at(i + 1, j + 1), at(i, j + 1)]);
+                    }
+                }
+            }
+        }
+        Shape::Quad { .. } | Shape::Box { .. } => {
+            for face in shape.faces() {
+                let Shape::Quad {
+                    corner,
+                    edge_u,
+                    edge_v,
+                } = face
+                else {
+                    return None;
+                };
+                let (c, u, v) = (V3::from(corner), V3::from(edge_u), V3::from(edge_v));
+                let n = u.cross(v).normalized();
+                let base = m.positions.len() as u32;
+                for (s, t) in [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)] {
+                    let p = c + u * s + v * t;
+                    m.positions.push([p.x, p.y, p.z]);
+                    m.normals.push([n.x, n.y, n.z]);
+                    m.texcoords.push([s, t]);
+                }
+                m.triangles.push([base, base + 1, base + 2]);
+                m.triangles.push([base, base + 2, base + 3]);
+            }
+        }
+        Shape::Plane { .. } | Shape::Mesh { .. } => return None,
+    }
+    Some(m)
 }
 
 /// `mesh` (the object `o`'s, which has a normal map) cut and given the
@@ -174,7 +286,7 @@ fn cut(
             }
             let frame = tangent::mesh_tangents(mesh, tri, w[1], w[2])
                 .expect("the mesh has texture coordinates");
-            let n = normal_at(uv, frame);
+            let n = apart(normal_at(uv, frame), (i + 2 * j) % 3);
             out.positions.push(p);
             out.texcoords.push(uv);
             out.normals.push([n.x, n.y, n.z]);
@@ -191,6 +303,21 @@ fn cut(
             }
         }
     }
+}
+
+/// How far (relative) the corners of one small triangle are set apart:
+/// POV-Ray draws a triangle whose three normals are equal (within about
+/// 1e-5, measured) with its face's normal, which would lose a tilt the
+/// map holds over a whole small triangle; 1e-4 of a radian shows in no
+/// pixel.
+const APART: f64 = 1e-4;
+
+/// `n` turned by `APART` times -1, 0 or 1 (`colour`): colours i + 2j
+/// (mod 3) give the three corners of every small triangle three
+/// different turns.
+fn apart(n: V3, colour: u32) -> V3 {
+    let (t, _) = crate::scene::texture::uv::plane_axes(n);
+    n + t * (APART * n.length() * (colour as f64 - 1.0))
 }
 
 #[cfg(test)]
@@ -212,8 +339,8 @@ mod tests {
     }
 
     /// Cut k x k, a triangle keeps its area, winding and texture
-    /// coordinates, and its corners on a shared edge are the
-    /// neighbour's, to the bit.
+    /// coordinates, its small triangles' corners are set apart, and its
+    /// corners on a shared edge are the neighbour's, to the bit.
     #[test]
     fn a_cut_triangle_keeps_its_area_and_meets_its_neighbour_exactly() {
         let m = square();
@@ -238,6 +365,12 @@ mod tests {
                 .triangles
                 .iter()
                 .all(|t| { (p(t[1]) - p(t[0])).cross(p(t[2]) - p(t[0])).z > 0.0 }));
+            // one normal everywhere, yet no small triangle's three alike
+            let n = |i: u32| V3::from(out.normals[i as usize]).normalized();
+            assert!(out.triangles.iter().all(|t| {
+                let d = |a: u32, b: u32| (n(a) - n(b)).length();
+                d(t[0], t[1]).min(d(t[1], t[2])).min(d(t[2], t[0])) > 0.9 * APART
+            }));
             // uv = (x, y) on this square
             for (q, uv) in out.positions.iter().zip(&out.texcoords) {
                 assert!((q[0] - uv[0]).abs() < 1e-12 && (q[1] - uv[1]).abs() < 1e-12);

@@ -25,8 +25,9 @@
 //!   oriented `area_light` of diameter 2r (9x9). `directional` -> a
 //!   `parallel` light 1e6 m away along `direction`, colour E*color.
 //! - objects: `sphere`, `plane`, `quad` (`polygon`), `box`, `mesh`
-//!   (`mesh2`, with `normal_vectors` when the file has vertex normals; a
-//!   normal-mapped mesh cut finer, its normals the map's: `pov_mesh_bumps`); an
+//!   (`mesh2`, with `normal_vectors` when the file has vertex normals); a
+//!   normal-mapped mesh, and a primitive whose normal map no height field
+//!   has, as a `mesh2` cut finer, its normals the map's (`pov_mesh_bumps`); an
 //!   object's `transform` after the shape as `scale`, `rotate`, `translate`
 //!   (see `placement`).
 //! - names: never written (comments say `lights[i]`, `objects[i]`): the
@@ -236,6 +237,22 @@ pub fn sdl_with(scene: &Scene, maps: MapSource) -> Result<String, String> {
 fn object(s: &mut String, i: usize, o: &Object, maps: MapSource) -> Result<(), String> {
     let mapped = o.material.has_maps();
     let place = o.transform.as_ref().map_or(String::new(), placement);
+    if super::pov_mesh_bumps::bakes(o) {
+        let text = super::pov_mesh_bumps::written(o, |m| mesh2(m, true))?;
+        // its other maps laid as a mesh's, by the baked texture coordinates
+        let as_mesh = Object {
+            shape: Shape::Mesh {
+                file: String::new(),
+            },
+            ..o.clone()
+        };
+        let texture = mapped_material(&as_mesh, maps)?;
+        let _ = writeln!(
+            s,
+            "// objects[{i}], baked with its normal map\n{text}\n  {texture}{place}\n}}"
+        );
+        return Ok(());
+    }
     if mapped && matches!(o.shape, Shape::Box { .. }) {
         let _ = writeln!(s, "// objects[{i}], a box as its six faces\nunion {{");
         for face in o.shape.faces() {
@@ -297,12 +314,7 @@ fn shape_of(o: &Object, mapped: bool) -> Result<String, String> {
         Shape::Mesh { ref file } => {
             let m = crate::scene::mesh::get(std::path::Path::new(file))
                 .map_err(|e| format!("objects.{}.shape.file: {e}", o.name))?;
-            if o.material.normal_map.is_some() {
-                // its normal map is in its normals (`pov_mesh_bumps`)
-                super::pov_mesh_bumps::written(o, &m, |b| mesh2(b, mapped))?.to_string()
-            } else {
-                mesh2(&m, mapped)
-            }
+            mesh2(&m, mapped)
         }
     })
 }
@@ -718,7 +730,7 @@ fn mapped_normal(
         return Ok(String::new());
     };
     if matches!(o.shape, Shape::Mesh { .. }) {
-        // a mesh's is in its normals (`shape_of`, `pov_mesh_bumps`)
+        // a mesh's is in its normals (`object`, `pov_mesh_bumps`)
         return Ok(String::new());
     }
     let (ch, pre, post) = placed(o, maps, MapKind::Normal, t, outer)?;

@@ -26,11 +26,10 @@ fn rows() -> Vec<(String, String)> {
         .collect()
 }
 
-/// The quad of side 1 at the origin, facing +z.
-fn unit_quad() -> crate::scene::Shape {
+/// The plane through the origin, facing +z.
+fn facing_plane() -> crate::scene::Shape {
     serde_json::from_value(
-        serde_json::json!({"type": "quad", "corner": [0.0, 0.0, 0.0],
-        "edge_u": [1.0, 0.0, 0.0], "edge_v": [0.0, 1.0, 0.0]}),
+        serde_json::json!({"type": "plane", "point": [0.0, 0.0, 0.0], "normal": [0.0, 0.0, 1.0]}),
     )
     .unwrap()
 }
@@ -61,15 +60,15 @@ fn scene_for(field: &str) -> Scene {
             m.specular_map = Some(TextureRef::File("t.png".into()));
             m.specular2 = Some(0.2);
         }
-        "a `normal_map` on an object whose `transform.scale` differs between axes" => {
+        "a `normal_map` on a `plane` whose `transform.scale` differs between axes" => {
             m.normal_map = Some(TextureRef::File("t.png".into()));
-            s.objects[0].shape = unit_quad();
+            s.objects[0].shape = facing_plane();
             s.objects[0].transform =
                 serde_json::from_value(serde_json::json!({"scale": [1.0, 2.0, 1.0]})).unwrap();
         }
-        "a `normal_map` on a `plane`, `quad`, `box` or `sphere` more than 5 % of whose slopes are not a height field's there" => {
+        "a `normal_map` on a `plane` more than 5 % of whose slopes are not a height field's there" => {
             m.normal_map = Some(TextureRef::File(twisted_normal_map()));
-            s.objects[0].shape = unit_quad();
+            s.objects[0].shape = facing_plane();
         }
         "a texture map on a material with `transmission` > 0" => {
             m.color_map = Some(TextureRef::File("t.png".into()));
