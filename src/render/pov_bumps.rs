@@ -64,7 +64,7 @@ pub fn refused(h: &Heights) -> bool {
 /// height field's on its surface (the caller names the field).
 pub fn not_a_height_field(missed: f64) -> String {
     format!(
-        "{:.0} % of its slopes are not a height field's on this surface (at most {:.0} %: a map stretched unevenly by `scale` or the shape, a flat tile's map on a sphere, or twisted), and POV-Ray draws a normal map as a height's gradient; use phong, blender or mitsuba, or a map made for this scale",
+        "{:.0} % of its slopes are not a height field's on this surface (at most {:.0} %: a map stretched unevenly by `scale` or the shape, a flat tile's map on a sphere, or twisted), and POV-Ray draws a plane's normal map as a height's gradient (a quad's, box's, sphere's or mesh's it bakes into triangles, but a plane has no end); use phong, blender or mitsuba, a map made for this scale, or a quad",
         100.0 * missed,
         100.0 * MAX_MISSED
     )
