@@ -94,7 +94,12 @@ pub fn written(o: &Object, write: impl FnOnce(&Mesh) -> String) -> Result<Arc<st
                 )
             })?),
         };
-        Ok(write(&baked(o, &mesh)?).into())
+        // without texture coordinates the map changes nothing, as in the
+        // built-in tracer
+        if mesh.texcoords.is_empty() {
+            return Ok(write(&mesh).into());
+        }
+        Ok(write(&baked(o, t, &mesh)?).into())
     })
 }
 
@@ -106,12 +111,7 @@ const SPHERE_GRID: [u32; 2] = [256, 128];
 /// coordinates (`texture::uv`) and outward normals; None for a plane or a
 /// mesh.
 fn tessellated(shape: &Shape) -> Option<Mesh> {
-    let mut m = Mesh {
-        positions: Vec::new(),
-        normals: Vec::new(),
-        texcoords: Vec::new(),
-        triangles: Vec::new(),
-    };
+    let mut m = Mesh::default();
     match *shape {
         Shape::Sphere { center, radius } => {
             let [nu, nv] = SPHERE_GRID;
@@ -169,27 +169,14 @@ fn tessellated(shape: &Shape) -> Option<Mesh> {
     Some(m)
 }
 
-/// `mesh` (the object `o`'s, which has a normal map) cut and given the
-/// map's normals, with its texture coordinates; the mesh itself when it
-/// has no texture coordinates (the map then changes nothing, as in the
-/// built-in tracer).
-fn baked(o: &Object, mesh: &Mesh) -> Result<Mesh, String> {
-    let Some(t) = o.material.map(MapKind::Normal) else {
-        return Ok(mesh.clone());
-    };
-    if mesh.texcoords.is_empty() {
-        return Ok(mesh.clone());
-    }
+/// `mesh` (the object `o`'s, with texture coordinates) cut and given the
+/// normals of its normal map `t`, with its texture coordinates.
+fn baked(o: &Object, t: &TextureRef, mesh: &Mesh) -> Result<Mesh, String> {
     let texels = texture::get(Path::new(t.file()), t.encoding(MapKind::Normal))
         .map_err(|e| format!("objects.{}.material.normal_map: {}: {e}", o.name, t.file()))?;
     let affine = o.transform.as_ref().map(Affine::new);
     let cuts = cuts(mesh, t, &texels);
-    let mut out = Mesh {
-        positions: Vec::new(),
-        normals: Vec::new(),
-        texcoords: Vec::new(),
-        triangles: Vec::new(),
-    };
+    let mut out = Mesh::default();
     for (tri, &k) in cuts.iter().enumerate() {
         cut(mesh, tri, k, &mut out, |uv, frame| {
             normal(frame, affine.as_ref(), map_value(t, &texels, uv))
@@ -345,12 +332,7 @@ mod tests {
     fn a_cut_triangle_keeps_its_area_and_meets_its_neighbour_exactly() {
         let m = square();
         for k in [1, 2, 3, 7] {
-            let mut out = Mesh {
-                positions: vec![],
-                normals: vec![],
-                texcoords: vec![],
-                triangles: vec![],
-            };
+            let mut out = Mesh::default();
             for tri in 0..2 {
                 cut(&m, tri, k, &mut out, |_, f| f.n);
             }
