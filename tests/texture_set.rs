@@ -152,8 +152,8 @@ fn lambertian_held_out(dir: &Path) -> f64 {
 /// texels 3 photographs or more see, and the deviation after at most 30 %
 /// of before; and the held-out photograph predicted better than by a
 /// per-texel Lambertian model of the same photographs. Its ratio to its
-/// noise floor is printed, not asserted: about 3, where a map at the side
-/// chosen can at best reach 2.7 (docs/results.md).
+/// noise floor is printed, not asserted: about 2.5 (1.2 asked), where the
+/// truth itself averaged to side 96 reaches 1.3 (docs/results.md).
 #[test]
 fn a_textured_sphere_accepts_the_colour_map_then_the_specular_map() {
     let (_tmp, dir, d, floors) = diagnosed(Surface::Sphere, Truth::Textured, "sphere");
@@ -169,12 +169,16 @@ fn a_textured_sphere_accepts_the_colour_map_then_the_specular_map() {
     assert!(held < lambert, "held out {held} %, Lambertian {lambert} %");
 }
 
+/// Also the deviation after at most 30 % of before. The colour error and
+/// the held-out ratio are printed, not asserted: about 0.044 (0.02 asked)
+/// and 12 (1.2 asked); docs/results.md, "The map's side: predicted, kept
+/// when it pays".
 #[test]
-#[ignore = "fails: the colour map is solved at side 16, too coarse for the checker, and no specular map is accepted (docs/results.md, textured sets)"]
 fn a_textured_plane_accepts_the_colour_map_then_the_specular_map() {
     let (_tmp, dir, d, floors) = diagnosed(Surface::Plane, Truth::Textured, "plane");
-    measures("plane", Surface::Plane, &dir, &d, &floors);
+    let [_, ratio, _] = measures("plane", Surface::Plane, &dir, &d, &floors);
     maps_accepted_in_order(&d, &dir);
+    assert!(ratio <= 0.3, "deviation after / before {ratio}");
 }
 
 #[test]

@@ -23,6 +23,7 @@
 use super::effects::covered;
 use super::inputs::Params;
 use super::map_evidence::{evidence, with_maps, without_maps};
+use super::map_side;
 use super::model::Model;
 use super::refits::Refits;
 use super::selection::{delta_bic, overdispersion_of};
@@ -68,18 +69,30 @@ pub fn prune(out: &Path, kept: &Scene) {
     }
 }
 
+/// How a solve chooses its maps' side below the finest the samples
+/// support (`texel_layout.rs`, a ceiling, not a choice).
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Side {
+    /// Each side scored by the criterion on the model as it stands, not
+    /// refitted (`selection::delta_bic`, with the overdispersion of the
+    /// finest side's residuals): a finer map buys its texels only where
+    /// its drop in SAD pays for them.
+    Criterion,
+    /// Each side scored by how well its maps predict photographs left out
+    /// of their solve (`map_side.rs`, no render).
+    Predicted,
+}
+
 /// The maps solved for `scene` with each photograph's `own` values,
-/// written into the diagnosis directory; the scene naming them and the
-/// values solved, or None when no value could be solved.
+/// written into the diagnosis directory; the scene naming them, the
+/// values solved and their layouts, or None when no value could be
+/// solved.
 ///
-/// The finest side the samples support (`texel_layout.rs`) is a ceiling,
-/// not a choice: the maps are solved at it and at each coarser side in
-/// turn (every object's side halved), each model scored by the criterion
-/// the round applies (`selection::delta_bic`, with the overdispersion of
-/// the finest side's residuals), and the best kept; the search stops at
-/// the first side that scores worse than the finer one. A finer map thus buys its
-/// texels only where its drop in SAD pays for them; `--map-size` fixes
-/// the side instead.
+/// `at` fixes the layouts (so two models are compared with the same map),
+/// as `--map-size` fixes the side; otherwise the maps are solved at the
+/// ceiling and at each coarser side in turn (every object's side halved),
+/// scored by `side`, and the best kept; the search stops at the first
+/// side that scores no better than the finer one.
 fn solve_for(
     fits: &mut Refits,
     scene: &Scene,
@@ -87,6 +100,7 @@ fn solve_for(
     held: Option<&[Image]>,
     (kind, tag): (MapKind, &str),
     at: Option<&[Option<Layout>]>,
+    side: Side,
 ) -> Result<Option<Solved>> {
     let covered = covered(scene, kind);
     let evidence = evidence(fits, scene, own, &covered, held, kind)?;
@@ -109,29 +123,43 @@ fn solve_for(
         return written(fits, &ceiling);
     }
     let (n, sad0) = texels::totals(&evidence);
-    let mut best: Option<(f64, Solved)> = None;
+    let response = scene.camera.response;
+    // The best score, its layouts, and its maps when scoring wrote them.
+    let mut best: Option<(f64, Vec<Option<Layout>>, Option<Solved>)> = None;
     let mut c = None;
     for shift in 0..=MAX_MAP_SIDE.trailing_zeros() {
         let sides = coarser(&ceiling, shift);
         if shift > 0 && sides == coarser(&ceiling, shift - 1) {
             break;
         }
-        let Some((s, count, _)) = written(fits, &sides)? else {
-            break;
+        let (score, solved) = match side {
+            Side::Predicted => {
+                let score = map_side::held_out_sad(&evidence, &sides, response, kind);
+                (score, None)
+            }
+            Side::Criterion => {
+                let Some(solved) = written(fits, &sides)? else {
+                    break;
+                };
+                let Some(m) = fits.model_of(solved.0.clone(), own)? else {
+                    break;
+                };
+                // One overdispersion for every side, the finest's: the most
+                // general model tried, as the round weighs its candidates.
+                let c = *c.get_or_insert_with(|| overdispersion_of(&m, fits.inputs));
+                (delta_bic(sad0, m.sad, n, solved.1, c), Some(solved))
+            }
         };
-        let Some(m) = fits.model_of(s.clone(), own)? else {
-            break;
-        };
-        // One overdispersion for every side, the finest's: the most general
-        // model tried, as the round weighs its candidates (`selection::weigh`).
-        let c = *c.get_or_insert_with(|| overdispersion_of(&m, fits.inputs));
-        let score = delta_bic(sad0, m.sad, n, count, c);
         if best.as_ref().is_some_and(|b| score >= b.0) {
             break;
         }
-        best = Some((score, (s, count, sides)));
+        best = Some((score, sides, solved));
     }
-    Ok(best.map(|(_, solved)| solved))
+    match best {
+        Some((_, _, Some(solved))) => Ok(Some(solved)),
+        Some((_, sides, None)) => written(fits, &sides),
+        None => Ok(None),
+    }
 }
 
 /// A solve's result: the scene naming the maps, the values solved, and
@@ -174,24 +202,88 @@ fn written_maps(
     Ok(Some((with_maps(scene, &refs, kind), count)))
 }
 
-/// The model with the maps of `kind` (`albedo_map`, `specular_map`):
-/// solved, the others refitted (`Refits::after_solve`), solved again, the
-/// better of the two kept, a specular map's exponent per texel beside it
-/// when that pays (`gloss.rs`); the model and the values solved (None:
-/// nothing could be solved).
+/// The model with the maps of `kind` (`albedo_map`, `specular_map`) and
+/// the values solved (None: nothing could be solved).
+///
+/// The side is chosen twice, by predicting photographs left out of the
+/// solve and by the criterion on the model as it stands (`Side`), and
+/// where the two differ each is carried through the refit (`solved_at`).
+/// The predicted side is kept when, refitted, it pays for its values by
+/// the round's criterion (with the overdispersion of the better of the
+/// two); else the criterion's. So the side is the one that predicts
+/// photographs it was not solved from, as long as the criterion would
+/// accept it. Neither rule alone holds: on a model still wrong elsewhere
+/// the unrefitted criterion reads a coarse map's residual along every
+/// edge as noise and keeps a side too coarse for the texture (a checkered
+/// plane: side 16, the deviation only halved, where side 64 cut it to a
+/// quarter and paid for itself once refitted); the prediction keeps the
+/// side that draws the texture best, which the round need not pay for (a
+/// broad lobe's highlights still unexplained: 3,278 values, refused,
+/// where a coarser map was accepted).
 pub(super) fn solved(
     fits: &mut Refits,
     model: &Model,
     round: usize,
     kind: MapKind,
 ) -> Result<Option<(Model, usize)>> {
-    let first = format!("round{round}_first");
+    let by_criterion = solved_at(fits, model, round, kind, Side::Criterion, None)?;
+    let skip = by_criterion.as_ref().map(|(_, _, first)| first.as_slice());
+    let by_prediction = solved_at(fits, model, round, kind, Side::Predicted, skip)?;
+    let (a, b) = match (by_criterion, by_prediction) {
+        (Some(a), Some(b)) => (a, b),
+        (one, other) => return Ok(one.or(other).map(|(m, count, _)| (m, count))),
+    };
+    let general = if a.0.sad <= b.0.sad { &a.0 } else { &b.0 };
+    let c = overdispersion_of(general, fits.inputs);
+    let n = fits.inputs.channel_values();
+    let pays = delta_bic(model.sad, b.0.sad, n, b.1, c) < 0.0;
+    let kept = if pays { b } else { a };
+    Ok(Some((kept.0, kept.1)))
+}
+
+/// A side carried through the refit: the model, the values solved, and
+/// the first solve's layouts.
+type Carried = (Model, usize, Vec<Option<Layout>>);
+
+/// `solved`'s model with its side chosen by `side`: the maps solved, the
+/// others refitted (`Refits::after_solve`), solved again, the better of
+/// the two kept, a specular map's exponent per texel beside it when that
+/// pays (`gloss.rs`); with the values solved and the first solve's
+/// layouts. None: nothing could be solved, or the first solve chose
+/// `skip`'s layouts (already carried through).
+fn solved_at(
+    fits: &mut Refits,
+    model: &Model,
+    round: usize,
+    kind: MapKind,
+    side: Side,
+    skip: Option<&[Option<Layout>]>,
+) -> Result<Option<Carried>> {
+    // Each rule's files are its own: the texels are read once per path.
+    let rule = if side == Side::Predicted {
+        "_heldout"
+    } else {
+        ""
+    };
+    let first = format!("round{round}{rule}_first");
     // The model's renders are its lit evidence: not drawn again.
     let held = Some(&model.images[..]);
-    let solve = solve_for(fits, &model.scene, &model.own, held, (kind, &first), None)?;
+    let solve = solve_for(
+        fits,
+        &model.scene,
+        &model.own,
+        held,
+        (kind, &first),
+        None,
+        side,
+    )?;
     let Some((scene, count1, layouts1)) = solve else {
         return Ok(None);
     };
+    if skip == Some(&layouts1[..]) {
+        return Ok(None);
+    }
+    let first_layouts = layouts1.clone();
     // The losing map stays on disk until the diagnosis prunes every map
     // its final model does not name (`prune`).
     let (mut fitted, mut count) = (fits.after_solve(&scene, &model.own)?, count1);
@@ -199,8 +291,8 @@ pub(super) fn solved(
     // Solved again on the refitted model without the first map: the
     // objects it covered are covered again.
     let bare = without_maps(&fitted.scene, &scene, &model.scene, kind);
-    let tag = format!("round{round}");
-    let again = solve_for(fits, &bare, &fitted.own, None, (kind, &tag), None)?;
+    let tag = format!("round{round}{rule}");
+    let again = solve_for(fits, &bare, &fitted.own, None, (kind, &tag), None, side)?;
     if let Some((again, count2, layouts2)) = again {
         let own = fitted.own.clone();
         if let Some(m) = fits.model_of(again, &own)? {
@@ -210,13 +302,13 @@ pub(super) fn solved(
         }
     }
     if kind == MapKind::Specular {
-        let tag = format!("round{round}_gloss");
+        let tag = format!("round{round}{rule}_gloss");
         let shine = super::gloss::beside(fits, &fitted, &model.scene, &layouts, (count, &tag))?;
-        if let Some(better) = shine {
-            return Ok(Some(better));
+        if let Some((better, values)) = shine {
+            return Ok(Some((better, values, first_layouts)));
         }
     }
-    Ok(Some((fitted, count)))
+    Ok(Some((fitted, count, first_layouts)))
 }
 
 /// `model` with the maps solved for it as it stands (no refit), the files
@@ -233,8 +325,16 @@ pub(super) fn texture_free(
 ) -> Result<Option<(Model, Vec<Option<Layout>>)>> {
     let held = Some(&model.images[..]);
     let color = (MapKind::Color, tag);
-    let Some((scene, _, layouts)) = solve_for(fits, &model.scene, &model.own, held, color, at)?
-    else {
+    let solve = solve_for(
+        fits,
+        &model.scene,
+        &model.own,
+        held,
+        color,
+        at,
+        Side::Criterion,
+    )?;
+    let Some((scene, _, layouts)) = solve else {
         return Ok(None);
     };
     Ok(fits.model_of(scene, &model.own)?.map(|m| (m, layouts)))

@@ -37,6 +37,7 @@ mod inputs;
 mod lanes;
 mod map_evidence;
 mod map_file;
+mod map_side;
 mod model;
 mod one_refit;
 pub mod photo;
@@ -67,7 +68,6 @@ use refits::Refits;
 use residual::Residual;
 use rounds::{rounds, Rounds};
 use schedule::Schedule;
-use selection::samples;
 use std::path::Path;
 use std::time::Instant;
 
@@ -130,11 +130,7 @@ fn diagnose(
     let residuals_before = model0.residuals(inputs);
     let mut model = fits.unchanged(model0)?;
     let refined = model.deviation(inputs);
-    let n: f64 = inputs
-        .shots
-        .iter()
-        .map(|s| samples(&s.target.image, s.target.mask.as_ref()))
-        .sum();
+    let n = inputs.channel_values();
     let Rounds {
         candidates,
         mut accepted,

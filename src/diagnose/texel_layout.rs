@@ -21,13 +21,17 @@
 //! floats).
 //!
 //! A plane's coordinates are metres without bound, so its map is scaled
-//! to hold in one tile the region where most samples lie (the middle
-//! `1 - 2 PLANE_TAIL` of them along each direction): a plane seen towards
-//! its horizon has a few pixels spread over hundreds of metres, and a
-//! tile stretched over them left the near field, where most pixels are,
-//! with texels many pixels wide. Those few pixels fall on the repeated
-//! tile (the lookup repeats, so the offset does not matter either); the
-//! other shapes' coordinates span [0, 1] already.
+//! to hold every sample in one tile, unless that tile would be more than
+//! `PLANE_STRETCH` times the extent of the middle `1 - 2 PLANE_TAIL` of
+//! the samples along a direction: a plane seen towards its horizon has a
+//! few pixels spread over hundreds of metres, and a tile stretched over
+//! them left the near field, where most pixels are, with texels many
+//! pixels wide. Those few pixels fall on the repeated tile (the lookup
+//! repeats, so the offset does not matter either). A tile that held only
+//! the middle 90 % folded the other 10 % of an ordinary view onto it,
+//! where they contradict the pixels they land on (a textured plane seen
+//! from 3 m: its map refused at side 64). The other shapes' coordinates
+//! span [0, 1] already.
 
 use crate::render::SurfaceCoords;
 use crate::scene::{Scene, Shape};
@@ -42,9 +46,15 @@ pub const MAX_MAP_SIDE: u32 = 1024;
 /// two samples besides the one that sets it.
 const MIN_SAMPLES: usize = 3;
 
-/// The share of a plane's samples left outside its tile at each end of
-/// each direction (`plane_scale`).
+/// The share of a plane's samples at each end of each direction that
+/// measures how far its middle extends (`plane_scale`).
 const PLANE_TAIL: f64 = 0.05;
+
+/// The longest a plane's tile may be, in extents of its middle samples:
+/// twice costs one step of side (a power of two) for the same texel size,
+/// which the side search affords; further would be a horizon's few pixels
+/// deciding the near field's texel size.
+const PLANE_STRETCH: f64 = 2.0;
 
 /// One object's map: its side and the scale of (u, v).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -124,8 +134,9 @@ pub fn layouts(
         .collect()
 }
 
-/// The scale that maps the middle `1 - 2 PLANE_TAIL` of `uvs` along each
-/// direction to a little under one tile.
+/// The scale that maps all of `uvs` along each direction to a little
+/// under one tile, or `PLANE_STRETCH` times their middle's extent where
+/// that is shorter.
 fn plane_scale(uvs: &[[f64; 2]]) -> [f64; 2] {
     let extent = |k: usize| {
         let mut v: Vec<f64> = uvs.iter().map(|p| p[k]).filter(|x| x.is_finite()).collect();
@@ -134,7 +145,8 @@ fn plane_scale(uvs: &[[f64; 2]]) -> [f64; 2] {
         }
         v.sort_by(f64::total_cmp);
         let at = |q: f64| v[((v.len() - 1) as f64 * q).round() as usize];
-        at(1.0 - PLANE_TAIL) - at(PLANE_TAIL)
+        let middle = at(1.0 - PLANE_TAIL) - at(PLANE_TAIL);
+        (at(1.0) - at(0.0)).min(PLANE_STRETCH * middle)
     };
     [0, 1].map(|k| {
         let e = extent(k);
@@ -240,17 +252,19 @@ mod tests {
     }
 
     #[test]
-    fn a_plane_tile_holds_where_most_samples_lie() {
-        // A plane seen over 3 m by 1 m fits one tile...
+    fn a_plane_tile_holds_every_sample_unless_a_few_lie_far_off() {
+        // A plane seen over 3 m by 1 m fits one tile, every sample in it...
         let mut pts: Vec<[f64; 2]> = (0..=100)
             .map(|i| [-1.0 + 3.0 * i as f64 / 100.0, i as f64 / 100.0])
             .collect();
         let s = plane_scale(&pts);
-        let (a, b) = (s[0] * 2.7, s[1] * 0.9);
+        let (a, b) = (s[0] * 3.0, s[1] * 1.0);
         assert!(a < 1.0 && a > 0.99 && b < 1.0 && b > 0.99, "{s:?}");
-        // ... and a few samples far off towards a horizon do not stretch it.
+        // ... and a few samples far off towards a horizon stretch it to
+        // twice the middle 90 % (2.7 m by 0.9 m), not to them.
         pts.extend([[-300.0, 500.0], [250.0, 900.0]]);
         let t = plane_scale(&pts);
-        assert!(t[0] < 1.05 * s[0] && t[0] > 0.95 * s[0], "{t:?}");
+        let (a, b) = (t[0] * 2.0 * 2.7, t[1] * 2.0 * 0.9);
+        assert!(a < 1.05 && a > 0.95 && b < 1.05 && b > 0.95, "{t:?}");
     }
 }

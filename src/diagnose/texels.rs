@@ -80,7 +80,10 @@ pub struct ObjectMap {
 /// Per laid-out object, its samples in photograph and pixel order, one
 /// per pixel; and the criterion's N and SAD of the model without the
 /// maps over every counted pixel.
-fn samples(evidence: &[Evidence], layouts: &[Option<Layout>]) -> (Vec<Vec<Sample>>, f64, f64) {
+pub(super) fn samples(
+    evidence: &[Evidence],
+    layouts: &[Option<Layout>],
+) -> (Vec<Vec<Sample>>, f64, f64) {
     let mut out = vec![Vec::new(); layouts.len()];
     let (mut n, mut sad) = (0.0_f64, 0.0);
     for (k, e) in evidence.iter().enumerate() {
@@ -146,9 +149,20 @@ pub fn solve(
     response: Option<Response>,
     kind: MapKind,
 ) -> Vec<ObjectMap> {
-    let levels = Levels::new(response);
-    let scalar = kind == MapKind::Specular;
     let (samples, n, sad) = samples(evidence, layouts);
+    solve_samples(&samples, layouts, (n, sad), &Levels::new(response), kind)
+}
+
+/// `solve` from the samples of each object, with the criterion's N and
+/// SAD (`totals`) that price a value.
+pub(super) fn solve_samples(
+    samples: &[Vec<Sample>],
+    layouts: &[Option<Layout>],
+    (n, sad): (f64, f64),
+    levels: &Levels,
+    kind: MapKind,
+) -> Vec<ObjectMap> {
+    let scalar = kind == MapKind::Specular;
     // A colour map's texel is pinned by its object's other texels (seen
     // by two photographs or more); a highlight is pinned only by another.
     // A scalar map's one value is fitted to the three channels together.
@@ -159,7 +173,7 @@ pub fn solve(
     };
     let cost = value_cost(n, sad);
     let mut maps = Vec::new();
-    for (object, (layout, samples)) in layouts.iter().zip(&samples).enumerate() {
+    for (object, (layout, samples)) in layouts.iter().zip(samples).enumerate() {
         let Some(layout) = *layout else { continue };
         if photographs(samples) < MIN_PHOTOGRAPHS {
             continue;
@@ -170,7 +184,7 @@ pub fn solve(
         let mut cell_sad = vec![0.0; texels];
         for channels in fits {
             let rule = (cost, per_texel);
-            let fitted = fit_channels(samples, channels.clone(), texels, &levels, rule);
+            let fitted = fit_channels(samples, channels.clone(), texels, levels, rule);
             let Fitted { m, kept, .. } = &fitted;
             for (a, b) in cell_sad.iter_mut().zip(&fitted.cell_sad) {
                 *a += b;
