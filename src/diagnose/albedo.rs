@@ -26,7 +26,7 @@ use super::map_evidence::{evidence, with_maps, without_maps};
 use super::map_side;
 use super::model::Model;
 use super::refits::Refits;
-use super::selection::{delta_bic, overdispersion_of};
+use super::selection::{channel_values, delta_bic, overdispersion_of};
 use super::texel_layout::{layouts, Layout, MAX_MAP_SIDE};
 use super::texels::{self, Evidence};
 use crate::error::{Error, Result};
@@ -235,7 +235,7 @@ pub(super) fn solved(
     };
     let general = if a.0.sad <= b.0.sad { &a.0 } else { &b.0 };
     let c = overdispersion_of(general, fits.inputs);
-    let n = fits.inputs.channel_values();
+    let n = channel_values(fits.inputs);
     let pays = delta_bic(model.sad, b.0.sad, n, b.1, c) < 0.0;
     let kept = if pays { b } else { a };
     Ok(Some((kept.0, kept.1)))

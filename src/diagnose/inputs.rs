@@ -106,13 +106,6 @@ impl SetInputs {
         }
     }
 
-    /// The criterion's N: the channel values counted over every
-    /// photograph fitted.
-    pub fn channel_values(&self) -> f64 {
-        let counted = |s: &Shot| super::selection::samples(&s.target.image, s.target.mask.as_ref());
-        self.shots.iter().map(counted).sum()
-    }
-
     /// The set fit in `dir`, or None when `dir` holds a fit of one
     /// photograph; the shots `hold_out` names held out besides the fit's.
     pub fn from_fit_dir(dir: &Path, hold_out: &[String]) -> Result<Option<SetInputs>> {

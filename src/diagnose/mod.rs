@@ -130,7 +130,7 @@ fn diagnose(
     let residuals_before = model0.residuals(inputs);
     let mut model = fits.unchanged(model0)?;
     let refined = model.deviation(inputs);
-    let n = inputs.channel_values();
+    let n = selection::channel_values(inputs);
     let Rounds {
         candidates,
         mut accepted,

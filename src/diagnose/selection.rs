@@ -40,6 +40,14 @@ pub fn samples(target: &Image, mask: Option<&Mask>) -> f64 {
     }) as f64
 }
 
+/// The criterion's N over a set: the channel values counted over every
+/// photograph fitted.
+pub(super) fn channel_values(inputs: &SetInputs) -> f64 {
+    let counted =
+        |s: &crate::fit::set::shots::Shot| samples(&s.target.image, s.target.mask.as_ref());
+    inputs.shots.iter().map(counted).sum()
+}
+
 /// The criterion's change from a model with SAD `sad0` to one with SAD
 /// `sad1` and `added` more free values, over `n` channel values whose
 /// overdispersion is `c` (1: independent).
