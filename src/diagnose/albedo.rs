@@ -4,9 +4,8 @@
 //! (`material.specular_map`), a multiplier of the specular strength per
 //! texel, shared by every photograph and solved from all of them that see
 //! the texel, whatever the camera and light of each
-//! (`texels.rs`; the finest resolution the samples support in
-//! `texel_layout.rs`, the side kept chosen by the criterion in
-//! `solve_for`). No search could fit it. Values with evidence in fewer
+//! (`map_solve.rs`: the evidence, the finest resolution the samples
+//! support, a side chosen below it; the side kept here, `solved`). No search could fit it. Values with evidence in fewer
 //! than two photographs stay 1 (the scalar colour) and are not counted,
 //! so on a single photograph nothing is solved and the effect is no
 //! candidate; nor are values whose drop of the SAD does not pay for them
@@ -20,18 +19,13 @@
 //! each. The maps are written into the diagnosis
 //! directory as 16-bit linear PNG (`map_file.rs`, which names them).
 
-use super::effects::covered;
-use super::inputs::Params;
-use super::map_evidence::{evidence, with_maps, without_maps};
-use super::map_side;
+use super::map_evidence::without_maps;
+use super::map_solve::{choose, gather, solve_for, solve_gathered, written_at, Side, Solved};
 use super::model::Model;
 use super::refits::Refits;
 use super::selection::{channel_values, delta_bic, overdispersion_of};
-use super::texel_layout::{layouts, Layout, MAX_MAP_SIDE};
-use super::texels::{self, Evidence};
-use crate::error::{Error, Result};
-use crate::metric::Mask;
-use crate::raster::Image;
+use super::texel_layout::Layout;
+use crate::error::Result;
 use crate::scene::texture::{MapKind, TextureRef};
 use crate::scene::Scene;
 use std::path::{Path, PathBuf};
@@ -69,145 +63,12 @@ pub fn prune(out: &Path, kept: &Scene) {
     }
 }
 
-/// How a solve chooses its maps' side below the finest the samples
-/// support (`texel_layout.rs`, a ceiling, not a choice).
-#[derive(Clone, Copy, Debug, PartialEq)]
-enum Side {
-    /// Each side scored by the criterion on the model as it stands, not
-    /// refitted (`selection::delta_bic`, with the overdispersion of the
-    /// finest side's residuals): a finer map buys its texels only where
-    /// its drop in SAD pays for them.
-    Criterion,
-    /// Each side scored by how well its maps predict photographs left out
-    /// of their solve (`map_side.rs`, no render).
-    Predicted,
-}
-
-/// The maps solved for `scene` with each photograph's `own` values,
-/// written into the diagnosis directory; the scene naming them, the
-/// values solved and their layouts, or None when no value could be
-/// solved.
-///
-/// `at` fixes the layouts (so two models are compared with the same map),
-/// as `--map-size` fixes the side; otherwise the maps are solved at the
-/// ceiling and at each coarser side in turn (every object's side halved),
-/// scored by `side`, and the best kept; the search stops at the first
-/// side that scores no better than the finer one.
-fn solve_for(
-    fits: &mut Refits,
-    scene: &Scene,
-    own: &[Params],
-    held: Option<&[Image]>,
-    (kind, tag): (MapKind, &str),
-    at: Option<&[Option<Layout>]>,
-    side: Side,
-) -> Result<Option<Solved>> {
-    let covered = covered(scene, kind);
-    let evidence = evidence(fits, scene, own, &covered, held, kind)?;
-    let inside: Vec<_> = evidence
-        .iter()
-        .map(|e| {
-            let (w, h) = e.target.dimensions();
-            (&e.coords, Mask::counted(e.mask, (w * h) as usize))
-        })
-        .collect();
-    let ceiling = layouts(scene, &covered, &inside, fits.config.map_size);
-    let written = |fits: &mut Refits, layouts: &[Option<Layout>]| {
-        let maps = written_maps(fits, scene, &evidence, layouts, (kind, tag))?;
-        Ok::<_, Error>(maps.map(|(s, count)| (s, count, layouts.to_vec())))
-    };
-    if let Some(at) = at {
-        return written(fits, at);
-    }
-    if fits.config.map_size.is_some() {
-        return written(fits, &ceiling);
-    }
-    let (n, sad0) = texels::totals(&evidence);
-    let response = scene.camera.response;
-    // The best score, its layouts, and its maps when scoring wrote them.
-    let mut best: Option<(f64, Vec<Option<Layout>>, Option<Solved>)> = None;
-    let mut c = None;
-    for shift in 0..=MAX_MAP_SIDE.trailing_zeros() {
-        let sides = coarser(&ceiling, shift);
-        if shift > 0 && sides == coarser(&ceiling, shift - 1) {
-            break;
-        }
-        let (score, solved) = match side {
-            Side::Predicted => {
-                let score = map_side::held_out_sad(&evidence, &sides, response, kind);
-                (score, None)
-            }
-            Side::Criterion => {
-                let Some(solved) = written(fits, &sides)? else {
-                    break;
-                };
-                let Some(m) = fits.model_of(solved.0.clone(), own)? else {
-                    break;
-                };
-                // One overdispersion for every side, the finest's: the most
-                // general model tried, as the round weighs its candidates.
-                let c = *c.get_or_insert_with(|| overdispersion_of(&m, fits.inputs));
-                (delta_bic(sad0, m.sad, n, solved.1, c), Some(solved))
-            }
-        };
-        if best.as_ref().is_some_and(|b| score >= b.0) {
-            break;
-        }
-        best = Some((score, sides, solved));
-    }
-    match best {
-        Some((_, _, Some(solved))) => Ok(Some(solved)),
-        Some((_, sides, None)) => written(fits, &sides),
-        None => Ok(None),
-    }
-}
-
-/// A solve's result: the scene naming the maps, the values solved, and
-/// the layouts they were solved at.
-type Solved = (Scene, usize, Vec<Option<Layout>>);
-
-/// `ceiling` with every side shifted down by `shift` (at least 1).
-fn coarser(ceiling: &[Option<Layout>], shift: u32) -> Vec<Option<Layout>> {
-    ceiling
-        .iter()
-        .map(|l| {
-            l.map(|l| Layout {
-                side: (l.side >> shift).max(1),
-                ..l
-            })
-        })
-        .collect()
-}
-
-/// The maps solved at `layouts` from `evidence`, written into the
-/// diagnosis directory; `scene` naming them and the values solved (None:
-/// nothing solved).
-fn written_maps(
-    fits: &Refits,
-    scene: &Scene,
-    evidence: &[Evidence],
-    layouts: &[Option<Layout>],
-    (kind, tag): (MapKind, &str),
-) -> Result<Option<(Scene, usize)>> {
-    let solved = texels::solve(evidence, layouts, scene.camera.response, kind);
-    if solved.is_empty() {
-        return Ok(None);
-    }
-    let mut refs = Vec::new();
-    for map in &solved {
-        let path = super::map_file::path(fits.out, kind, tag, map.object, map.layout.side)?;
-        refs.push((map.object, super::map_file::write(&path, map)?));
-    }
-    let count = solved.iter().map(|m| m.count).sum();
-    Ok(Some((with_maps(scene, &refs, kind), count)))
-}
-
 /// The model with the maps of `kind` (`albedo_map`, `specular_map`) and
 /// the values solved (None: nothing could be solved).
 ///
 /// The side is chosen twice, by predicting photographs left out of the
 /// solve and by the criterion on the model as it stands (`Side`), and
-/// where the two differ each is carried through the refit (`solved_at`).
+/// where the two differ each is carried through the refit (`first_solves`, `carried`).
 /// The predicted side is kept when, refitted, it pays for its values by
 /// the round's criterion (with the overdispersion of the better of the
 /// two); else the criterion's. So the side is the one that predicts
@@ -226,64 +87,70 @@ pub(super) fn solved(
     round: usize,
     kind: MapKind,
 ) -> Result<Option<(Model, usize)>> {
-    let by_criterion = solved_at(fits, model, round, kind, Side::Criterion, None)?;
-    let skip = by_criterion.as_ref().map(|(_, _, first)| first.as_slice());
-    let by_prediction = solved_at(fits, model, round, kind, Side::Predicted, skip)?;
+    let (first_criterion, first_prediction) = first_solves(fits, model, round, kind)?;
+    let mut carry = |first: Option<Solved>, side| {
+        first
+            .map(|first| carried(fits, model, round, kind, side, first))
+            .transpose()
+    };
+    let by_criterion = carry(first_criterion, Side::Criterion)?;
+    let by_prediction = carry(first_prediction, Side::Predicted)?;
     let (a, b) = match (by_criterion, by_prediction) {
         (Some(a), Some(b)) => (a, b),
-        (one, other) => return Ok(one.or(other).map(|(m, count, _)| (m, count))),
+        (one, other) => return Ok(one.or(other)),
     };
     let general = if a.0.sad <= b.0.sad { &a.0 } else { &b.0 };
     let c = overdispersion_of(general, fits.inputs);
     let n = channel_values(fits.inputs);
     let pays = delta_bic(model.sad, b.0.sad, n, b.1, c) < 0.0;
-    let kept = if pays { b } else { a };
-    Ok(Some((kept.0, kept.1)))
+    Ok(Some(if pays { b } else { a }))
 }
 
-/// A side carried through the refit: the model, the values solved, and
-/// the first solve's layouts.
-type Carried = (Model, usize, Vec<Option<Layout>>);
+/// Each rule's first solve for `model`, both from one evidence (the
+/// model's renders are its lit evidence: not drawn again): the
+/// criterion's, and the prediction's where its layouts differ (None
+/// where they are the same: those maps are already carried). The files
+/// of each rule are its own (`_heldout` for the prediction's), so the
+/// texels are read once per path.
+fn first_solves(
+    fits: &mut Refits,
+    model: &Model,
+    round: usize,
+    kind: MapKind,
+) -> Result<(Option<Solved>, Option<Solved>)> {
+    let (scene, own) = (&model.scene, &model.own);
+    let g = gather(fits, scene, own, Some(&model.images[..]), kind)?;
+    let tag = format!("round{round}_first");
+    let by_criterion = solve_gathered(fits, scene, own, &g, (kind, &tag), None, Side::Criterion)?;
+    let tag = format!("round{round}_heldout_first");
+    let predicted = choose(fits, scene, own, &g, (kind, &tag), Side::Predicted)?;
+    let by_prediction = match predicted {
+        Some(p) if by_criterion.as_ref().map(|s| &s.2[..]) != Some(p.layouts()) => {
+            written_at(fits, scene, &g, p.layouts(), (kind, &tag))?
+        }
+        _ => None,
+    };
+    Ok((by_criterion, by_prediction))
+}
 
-/// `solved`'s model with its side chosen by `side`: the maps solved, the
-/// others refitted (`Refits::after_solve`), solved again, the better of
-/// the two kept, a specular map's exponent per texel beside it when that
-/// pays (`gloss.rs`); with the values solved and the first solve's
-/// layouts. None: nothing could be solved, or the first solve chose
-/// `skip`'s layouts (already carried through).
-fn solved_at(
+/// `solved`'s model from a rule's `first` solve: the others refitted with
+/// its maps (`Refits::after_solve`), the maps solved again by the same
+/// rule on the refitted model, the better of the two kept, a specular
+/// map's exponent per texel beside it when that pays (`gloss.rs`); with
+/// the values solved.
+fn carried(
     fits: &mut Refits,
     model: &Model,
     round: usize,
     kind: MapKind,
     side: Side,
-    skip: Option<&[Option<Layout>]>,
-) -> Result<Option<Carried>> {
-    // Each rule's files are its own: the texels are read once per path.
+    (scene, count1, layouts1): Solved,
+) -> Result<(Model, usize)> {
     let rule = if side == Side::Predicted {
         "_heldout"
     } else {
         ""
     };
-    let first = format!("round{round}{rule}_first");
-    // The model's renders are its lit evidence: not drawn again.
-    let held = Some(&model.images[..]);
-    let solve = solve_for(
-        fits,
-        &model.scene,
-        &model.own,
-        held,
-        (kind, &first),
-        None,
-        side,
-    )?;
-    let Some((scene, count1, layouts1)) = solve else {
-        return Ok(None);
-    };
-    if skip == Some(&layouts1[..]) {
-        return Ok(None);
-    }
-    let first_layouts = layouts1.clone();
     // The losing map stays on disk until the diagnosis prunes every map
     // its final model does not name (`prune`).
     let (mut fitted, mut count) = (fits.after_solve(&scene, &model.own)?, count1);
@@ -304,11 +171,11 @@ fn solved_at(
     if kind == MapKind::Specular {
         let tag = format!("round{round}{rule}_gloss");
         let shine = super::gloss::beside(fits, &fitted, &model.scene, &layouts, (count, &tag))?;
-        if let Some((better, values)) = shine {
-            return Ok(Some((better, values, first_layouts)));
+        if let Some(better) = shine {
+            return Ok(better);
         }
     }
-    Ok(Some((fitted, count, first_layouts)))
+    Ok((fitted, count))
 }
 
 /// `model` with the maps solved for it as it stands (no refit), the files

@@ -38,6 +38,7 @@ mod lanes;
 mod map_evidence;
 mod map_file;
 mod map_side;
+mod map_solve;
 mod model;
 mod one_refit;
 pub mod photo;
