@@ -3,10 +3,11 @@
 //! the diffuse colour per texel and channel, or a specular one
 //! (`material.specular_map`), a multiplier of the specular strength per
 //! texel, shared by every photograph and solved from all of them that see
-//! the texel, whatever the camera and light of each
-//! (`map_solve.rs`: the evidence, the finest resolution the samples
-//! support, a side chosen below it; the side kept here, `solved`). No search could fit it. Values with evidence in fewer
-//! than two photographs stay 1 (the scalar colour) and are not counted,
+//! the texel, whatever the camera and light of each (`map_solve.rs`: the
+//! evidence, the finest resolution the samples support, a side chosen
+//! below it; the side kept here, `solved`). No search could fit it.
+//! Values with evidence in fewer than two photographs stay 1 (the scalar
+//! colour) and are not counted,
 //! so on a single photograph nothing is solved and the effect is no
 //! candidate; nor are values whose drop of the SAD does not pay for them
 //! in the criterion.
@@ -68,8 +69,8 @@ pub fn prune(out: &Path, kept: &Scene) {
 ///
 /// The side is chosen twice, by predicting photographs left out of the
 /// solve and by the criterion on the model as it stands (`Side`), and
-/// where the two differ each is carried through the refit (`first_solves`, `carried`).
-/// The predicted side is kept when, refitted, it pays for its values by
+/// where the two differ each is carried through the refit
+/// (`first_solves`, `carried`). The predicted side is kept when, refitted, it pays for its values by
 /// the round's criterion (with the overdispersion of the better of the
 /// two); else the criterion's. So the side is the one that predicts
 /// photographs it was not solved from, as long as the criterion would
