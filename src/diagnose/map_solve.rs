@@ -135,8 +135,12 @@ impl Choice {
 /// The layouts `side` keeps for `g` (the ceiling when `--map-size` fixes
 /// the side): the maps are solved at the ceiling and at each coarser side
 /// in turn (every object's side halved), scored by `side`, and the best
-/// kept; the search stops at the first side that scores no better than
-/// the finer one. None: no value could be solved.
+/// kept (the finer of two equal scores). Every side is scored: where the
+/// photographs fix the camera, the finest sides give each pixel its own
+/// texel and score alike, so a search that stopped at the first side no
+/// better than the finer one stalled on that plateau and kept a per-pixel
+/// map. It stops only at a side where nothing can be solved, or where
+/// halving no longer changes a side. None: no value could be solved.
 pub(super) fn choose(
     fits: &mut Refits,
     scene: &Scene,
@@ -179,7 +183,7 @@ pub(super) fn choose(
             }
         };
         if best.as_ref().is_some_and(|b| score >= b.0) {
-            break;
+            continue;
         }
         best = Some((score, choice));
     }
