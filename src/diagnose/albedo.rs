@@ -7,10 +7,9 @@
 //! evidence, the finest resolution the samples support, a side chosen
 //! below it; the side kept here, `solved`). No search could fit it.
 //! Values with evidence in fewer than two photographs stay 1 (the scalar
-//! colour) and are not counted,
-//! so on a single photograph nothing is solved and the effect is no
-//! candidate; nor are values whose drop of the SAD does not pay for them
-//! in the criterion.
+//! colour) and are not counted, so on a single photograph nothing is
+//! solved and the effect is no candidate; nor are values whose drop of
+//! the SAD does not pay for them in the criterion.
 //!
 //! The map is solved, the model's other free parameters refitted with it
 //! in the scene, and the map solved once more against the refitted model
@@ -70,9 +69,9 @@ pub fn prune(out: &Path, kept: &Scene) {
 /// The side is chosen twice, by predicting photographs left out of the
 /// solve and by the criterion on the model as it stands (`Side`), and
 /// where the two differ each is carried through the refit
-/// (`first_solves`, `carried`). The predicted side is kept when, refitted, it pays for its values by
-/// the round's criterion (with the overdispersion of the better of the
-/// two); else the criterion's. So the side is the one that predicts
+/// (`first_solves`, `carried`). The predicted side is kept when,
+/// refitted, it pays for its values by the round's criterion (with the
+/// overdispersion of the better of the two); else the criterion's. So the side is the one that predicts
 /// photographs it was not solved from, as long as the criterion would
 /// accept it. Neither rule alone holds: on a model still wrong elsewhere
 /// the unrefitted criterion reads a coarse map's residual along every
