@@ -71,7 +71,8 @@ pub fn prune(out: &Path, kept: &Scene) {
 /// where the two differ each is carried through the refit
 /// (`first_solves`, `carried`). The predicted side is kept when,
 /// refitted, it pays for its values by the round's criterion (with the
-/// overdispersion of the better of the two); else the criterion's. So the side is the one that predicts
+/// overdispersion of the better of the two) and is not dominated (as
+/// many values or more for no lower SAD); else the criterion's. So the side is the one that predicts
 /// photographs it was not solved from, as long as the criterion would
 /// accept it. Neither rule alone holds: on a model still wrong elsewhere
 /// the unrefitted criterion reads a coarse map's residual along every
@@ -102,7 +103,11 @@ pub(super) fn solved(
     let general = if a.0.sad <= b.0.sad { &a.0 } else { &b.0 };
     let c = overdispersion_of(general, fits.inputs);
     let n = channel_values(fits.inputs);
-    let pays = delta_bic(model.sad, b.0.sad, n, b.1, c) < 0.0;
+    // A predicted side with no fewer values and no lower SAD than the
+    // criterion's is dominated: it can only be paying against the model
+    // before, which the criterion's side beats with less.
+    let dominated = b.1 >= a.1 && b.0.sad >= a.0.sad;
+    let pays = !dominated && delta_bic(model.sad, b.0.sad, n, b.1, c) < 0.0;
     Ok(Some(if pays { b } else { a }))
 }
 

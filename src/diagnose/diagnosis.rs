@@ -27,25 +27,56 @@ pub struct Candidate {
     /// Which refit counted: "warm" or "from scratch".
     pub refit: String,
     /// A set's candidate weighed on the residual without the albedo's
-    /// part as well (`footing.rs`); `delta_bic`, `gain` and
-    /// `overdispersion` are the footing's that `counted` names.
+    /// part, or against the finest colour map, as well (`footing.rs`);
+    /// `delta_bic`, `gain` and `overdispersion` are the footing's that
+    /// `counted` names.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub footing: Option<Footing>,
 }
 
-/// A candidate weighed twice: on the residual as it is, and with a colour
-/// map solved for the model before and after it (diagnosis.json's
-/// `footing`).
+/// A candidate weighed on more than one footing (diagnosis.json's
+/// `footing`, `footing.rs`): on the residual as it is; with a colour map
+/// solved for the model before and after it while no object has one
+/// (texture-free); against the finest colour map the photographs support
+/// once the diagnosis has added one (finest-map).
 #[derive(Clone, Debug, Serialize)]
 pub struct Footing {
-    /// "plain" or "texture-free": the footing whose criterion is lower.
+    /// "plain", "texture-free" (the lower criterion of the two) or
+    /// "finest-map" (higher than the one counted before it).
     pub counted: &'static str,
     pub plain_delta_bic: f64,
     pub plain_gain: f64,
-    pub texture_free_delta_bic: f64,
-    pub texture_free_gain: f64,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub texture_free_delta_bic: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub texture_free_gain: Option<f64>,
     /// ĉ of the texture-free footing's residuals.
-    pub texture_free_overdispersion: f64,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub texture_free_overdispersion: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub finest_map_delta_bic: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub finest_map_gain: Option<f64>,
+    /// ĉ of the finest-map footing's residuals.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub finest_map_overdispersion: Option<f64>,
+}
+
+impl Footing {
+    /// A candidate's plain footing, counted until another is.
+    pub fn plain(delta_bic: f64, gain: f64) -> Footing {
+        Footing {
+            counted: "plain",
+            plain_delta_bic: delta_bic,
+            plain_gain: gain,
+            texture_free_delta_bic: None,
+            texture_free_gain: None,
+            texture_free_overdispersion: None,
+            finest_map_delta_bic: None,
+            finest_map_gain: None,
+            finest_map_overdispersion: None,
+        }
+    }
 }
 
 /// diagnosis.json.

@@ -56,7 +56,7 @@ pub(super) fn solve_for(
 /// (`texel_layout.rs`, a ceiling, not a choice).
 pub(super) struct Gathered<'a> {
     evidence: Vec<Evidence<'a>>,
-    ceiling: Vec<Option<Layout>>,
+    pub(super) ceiling: Vec<Option<Layout>>,
 }
 
 /// [`Gathered`] for `scene` with each photograph's `own` values (`held`:

@@ -21,6 +21,7 @@ use super::trials::Trial;
 use super::Candidate;
 use super::DiagnoseConfig;
 use crate::error::Result;
+use crate::scene::Scene;
 
 /// What the rounds found: the candidates of every round, the effects
 /// accepted, those removed again, and the imitations named.
@@ -41,7 +42,7 @@ pub(super) fn rounds(fits: &mut Refits, model: &mut Model, n: f64) -> Result<Rou
     let mut imitations = Vec::new();
     for round in 1..=fits.config.max_rounds {
         let accepted: Vec<String> = steps.iter().map(|s| s.effect.name().to_string()).collect();
-        let (found, chosen, named) = round_of(fits, model, &accepted, n, round)?;
+        let (found, chosen, named) = round_of(fits, model, (&base, &accepted), n, round)?;
         candidates.extend(found);
         imitations.extend(named);
         let Some(step) = chosen else {
@@ -83,10 +84,11 @@ fn evidence(residuals: &[Residual], effect: &dyn Effect) -> f64 {
 
 /// One round: every effect not in `accepted` tried; its candidates, ranked
 /// by evidence, and the accepted effect's step (`model` then its model).
+/// `base`: the model before the rounds (the maps it holds are the user's).
 fn round_of(
     fits: &mut Refits,
     model: &mut Model,
-    accepted: &[String],
+    (base, accepted): (&Scene, &[String]),
     n: f64,
     round: usize,
 ) -> Result<(Vec<Candidate>, Option<Step>, Vec<Imitation>)> {
@@ -134,6 +136,7 @@ fn round_of(
     weigh_round(&mut found, &models, sad0, n, inputs);
     let before = (&*model, null.as_ref());
     super::footing::weigh_texture_free(fits, before, &mut found, &models, n, round)?;
+    super::footing::weigh_finest_map(fits, base, before, &mut found, &models, (n, round))?;
     let chosen = choose(&found, fits.config);
     let named = chosen.map_or_else(Vec::new, |i| {
         imitations_of(&found, i, &models, model, inputs)
