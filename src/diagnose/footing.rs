@@ -1,8 +1,9 @@
 //! A set's candidates weighed a second time on the residual without the
 //! albedo's part: a colour map solved in closed form (`albedo.rs`) for the
 //! model before the round and for each candidate's refitted model as it
-//! stands (at the side chosen for the model before), the criterion taken between the two mapped models, and the
-//! lower of the two criteria counting (diagnosis.json's `footing`).
+//! stands (at the side chosen for the model before), the criterion taken
+//! between the two mapped models, and the lower of the two criteria
+//! counting (diagnosis.json's `footing`).
 //!
 //! Why: on an object with a painted albedo that no map yet describes, the
 //! albedo's misfit is most of the residual (on the trap sets of issue 32
@@ -29,7 +30,9 @@
 //! side-32 map 0.18 %, and a false response (a near-sRGB curve) took 17 %
 //! of that. An effect that explains the photographs gains whatever the
 //! map's side; one that takes only the coarse map's misfit gains nothing
-//! against the finest.
+//! against the finest. It is not the whole cure: against the finest map
+//! that response still took 8.3 %, the lobe the map was solved against
+//! (docs/results.md, "The finest-map footing").
 //!
 //! One photograph solves no map (`albedo.rs`), so only a set's rounds are
 //! weighed again; a closed-form colour map (the map itself) is weighed
