@@ -72,9 +72,9 @@ pub fn prune(out: &Path, kept: &Scene) {
 /// (`first_solves`, `carried`). The predicted side is kept when,
 /// refitted, it pays for its values by the round's criterion (with the
 /// overdispersion of the better of the two) and is not dominated (as
-/// many values or more for no lower SAD); else the criterion's. So the side is the one that predicts
-/// photographs it was not solved from, as long as the criterion would
-/// accept it. Neither rule alone holds: on a model still wrong elsewhere
+/// many values or more for no lower SAD); else the criterion's. So the
+/// side is the one that predicts photographs it was not solved from, as
+/// long as the criterion would accept it. Neither rule alone holds: on a model still wrong elsewhere
 /// the unrefitted criterion reads a coarse map's residual along every
 /// edge as noise and keeps a side too coarse for the texture (a checkered
 /// plane: side 16, the deviation only halved, where side 64 cut it to a
